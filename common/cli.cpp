@@ -1,0 +1,88 @@
+#include "common/cli.h"
+
+#include <cmath>
+#include <iostream>
+
+#include "common/not_implemented.h"
+
+namespace cl {
+
+namespace {
+const CLI::Validator kFinitePositive(
+    [](std::string& text) -> std::string {
+      try {
+        std::size_t used = 0;
+        const double value = std::stod(text, &used);
+        if (used == text.size() && std::isfinite(value) && value > 0.0) return {};
+      } catch (const std::exception&) {
+      }
+      return "must be a finite number > 0 (got " + text + ")";
+    },
+    "POSITIVE");
+}  // namespace
+
+void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
+  if (flags & kFlagScene) {
+    app.add_option("--scene", options.scene, "scene file (.json) or the name of a shipped scene")
+        ->capture_default_str();
+  }
+  if (flags & kFlagMethod) {
+    app.add_option("--method", options.method, "solver method")
+        ->check(CLI::IsMember(options.methods))
+        ->capture_default_str();
+  }
+  if (flags & kFlagIterations) {
+    app.add_option("--iterations", options.iterations, "solver iterations per step (0 allowed)")
+        ->check(CLI::Range(0, 100'000'000))
+        ->capture_default_str();
+  }
+  if (flags & kFlagDt) {
+    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(kFinitePositive);
+  }
+  if (flags & kFlagSteps) {
+    app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")
+        ->check(CLI::Range(0, 100'000'000));
+  }
+  if (flags & kFlagOut) app.add_option("--out", options.out, "directory for the CSV files");
+  if (flags & kFlagSummary) app.add_option("--summary", options.summary, "write the run summary (JSON) here");
+}
+
+Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir) {
+  Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir));
+  if (options.dt > 0.0) scene.dt = options.dt;
+  if (options.steps >= 0) scene.steps = options.steps;
+  return scene;
+}
+
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+  const std::string program = app.get_name();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::cout << app.help();
+    return 0;
+  } catch (const CLI::CallForAllHelp&) {
+    std::cout << app.help("", CLI::AppFormatMode::All);
+    return 0;
+  } catch (const CLI::ParseError& error) {
+    std::cerr << program << ": " << error.what() << " (see --help)\n";
+    return 2;
+  }
+  try {
+    return body();
+  } catch (const InputError& error) {
+    std::cerr << program << ": " << error.what() << "\n";
+    return 2;
+  } catch (const NotImplemented& error) {
+    std::cerr << program << ": " << error.what() << "; write it, then run again\n";
+    return 3;
+  } catch (const std::invalid_argument& error) {
+    std::cerr << program << ": invalid argument: " << error.what() << "\n";
+    return 2;
+  } catch (const std::exception& error) {
+    std::cerr << program << ": error: " << error.what() << "\n";
+    return 1;
+  }
+}
+
+}  // namespace cl

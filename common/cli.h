@@ -1,0 +1,50 @@
+#pragma once
+// The command line shared by every lab executable (COURSE.md §3) and the
+// wrapper that turns every failure into one line on stderr and an exit code:
+//   0 done, 2 bad input or usage, 3 a student function not implemented yet.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common/scene.h"
+
+namespace cl {
+
+// Which of the shared flags a lab takes; a lab only offers what it uses.
+enum CommonFlag : unsigned {
+  kFlagScene = 1u << 0,       // --scene FILE.json | NAME
+  kFlagMethod = 1u << 1,      // --method M
+  kFlagIterations = 1u << 2,  // --iterations K
+  kFlagDt = 1u << 3,          // --dt S
+  kFlagSteps = 1u << 4,       // --steps N
+  kFlagOut = 1u << 5,         // --out DIR
+  kFlagSummary = 1u << 6,     // --summary FILE.json
+};
+
+struct CommonOptions {
+  std::string scene;                 // name or path, as given
+  std::string method;
+  std::vector<std::string> methods;  // the choices for --method
+  int iterations = 10;
+  double dt = 0.0;                   // 0: the scene's
+  int steps = -1;                    // -1: the scene's
+  std::string out;                   // empty: no CSV files
+  std::string summary;               // empty: no summary file
+};
+
+// Registers the flags in `flags` on `app`. Set the defaults in `options`
+// (scene, method, methods, iterations) before calling.
+void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
+
+// Loads the scene named by --scene for a lab whose scenes live in
+// lab_scene_dir, and applies --dt and --steps. Throws InputError.
+Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir);
+
+// Parses the command line and runs `body`, mapping every failure to a single
+// stderr line and exit code: CLI and InputError -> 2, NotImplemented -> 3,
+// anything else -> 1. `body` returns the exit code for a run that finished.
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+
+}  // namespace cl

@@ -1,0 +1,31 @@
+#pragma once
+// A CSV table built in memory and written whole (see output.h).
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace cl {
+
+// A cell: a number (written with 17 significant digits), an integer or text.
+using CsvCell = std::variant<double, long long, std::string>;
+
+class CsvTable {
+ public:
+  explicit CsvTable(std::vector<std::string> columns);
+
+  // Appends a row; throws std::invalid_argument if its width is wrong.
+  void add_row(const std::vector<CsvCell>& cells);
+
+  std::size_t rows() const { return row_count_; }
+  const std::string& text() const { return text_; }
+
+  // Writes the table atomically to `path`.
+  void write(const std::string& path) const;
+
+ private:
+  std::size_t columns_;
+  std::size_t row_count_ = 0;
+  std::string text_;
+};
+
+}  // namespace cl

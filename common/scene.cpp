@@ -1,0 +1,539 @@
+#include "common/scene.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <Eigen/Geometry>
+#include <nlohmann/json.hpp>
+
+namespace cl {
+
+namespace {
+
+using nlohmann::json;
+namespace fs = std::filesystem;
+
+std::string show(const json& value) {
+  std::string text = value.dump();
+  if (text.size() > 40) text = text.substr(0, 37) + "...";
+  return text;
+}
+
+// Validation with error messages of the form "file: field[index].key: problem".
+class Reader {
+ public:
+  explicit Reader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
+    throw InputError(source_ + ": " + field + ": " + problem);
+  }
+
+  void require_object(const json& value, const std::string& field) const {
+    if (!value.is_object()) fail(field, "must be an object (got " + show(value) + ")");
+  }
+
+  void check_keys(const json& object, const std::set<std::string>& allowed,
+                  const std::string& field) const {
+    for (const auto& item : object.items()) {
+      if (allowed.count(item.key()) == 0) {
+        std::string known;
+        for (const std::string& key : allowed) known += (known.empty() ? "" : ", ") + key;
+        fail(join(field, item.key()), "unknown key (allowed: " + known + ")");
+      }
+    }
+  }
+
+  static std::string join(const std::string& field, const std::string& key) {
+    return field.empty() ? key : field + "." + key;
+  }
+
+  double number(const json& value, const std::string& field) const {
+    if (!value.is_number()) fail(field, "must be a number (got " + show(value) + ")");
+    const double result = value.get<double>();
+    if (!std::isfinite(result)) fail(field, "must be finite (got " + show(value) + ")");
+    return result;
+  }
+
+  double positive(const json& value, const std::string& field) const {
+    const double result = number(value, field);
+    if (!(result > 0.0)) fail(field, "must be > 0 (got " + show(value) + ")");
+    return result;
+  }
+
+  double non_negative(const json& value, const std::string& field) const {
+    const double result = number(value, field);
+    if (result < 0.0) fail(field, "must be >= 0 (got " + show(value) + ")");
+    return result;
+  }
+
+  std::int64_t integer(const json& value, const std::string& field) const {
+    if (!value.is_number_integer()) fail(field, "must be an integer (got " + show(value) + ")");
+    return value.get<std::int64_t>();
+  }
+
+  int integer_at_least(const json& value, const std::string& field, std::int64_t low,
+                       std::int64_t high = 100'000'000) const {
+    const std::int64_t result = integer(value, field);
+    if (result < low || result > high) {
+      fail(field, "must be an integer in [" + std::to_string(low) + ", " + std::to_string(high) +
+                      "] (got " + show(value) + ")");
+    }
+    return static_cast<int>(result);
+  }
+
+  int index(const json& value, const std::string& field, Eigen::Index count) const {
+    const std::int64_t result = integer(value, field);
+    if (result < 0 || result >= count) {
+      fail(field, "index out of range [0, " + std::to_string(count) + ") (got " + show(value) + ")");
+    }
+    return static_cast<int>(result);
+  }
+
+  Eigen::Vector3d vec3(const json& value, const std::string& field) const {
+    if (!value.is_array() || value.size() != 3) {
+      fail(field, "must be an array of 3 numbers (got " + show(value) + ")");
+    }
+    Eigen::Vector3d result;
+    for (int axis = 0; axis < 3; ++axis) {
+      result[axis] = number(value[static_cast<std::size_t>(axis)],
+                            field + "[" + std::to_string(axis) + "]");
+    }
+    return result;
+  }
+
+  bool boolean(const json& value, const std::string& field) const {
+    if (!value.is_boolean()) fail(field, "must be true or false (got " + show(value) + ")");
+    return value.get<bool>();
+  }
+
+  std::string string(const json& value, const std::string& field) const {
+    if (!value.is_string()) fail(field, "must be a string (got " + show(value) + ")");
+    return value.get<std::string>();
+  }
+
+  std::string one_of(const json& value, const std::string& field,
+                     const std::vector<std::string>& choices) const {
+    const std::string result = string(value, field);
+    if (std::find(choices.begin(), choices.end(), result) == choices.end()) {
+      std::string known;
+      for (const std::string& choice : choices) known += (known.empty() ? "" : ", ") + choice;
+      fail(field, "must be one of " + known + " (got " + show(value) + ")");
+    }
+    return result;
+  }
+
+  // Stiffness in N/m: a positive finite number or the string "inf" (a hard constraint).
+  double stiffness(const json& value, const std::string& field) const {
+    if (value.is_string()) {
+      if (value.get<std::string>() == "inf") return kInfiniteStiffness;
+      fail(field, "must be a number > 0 or \"inf\" (got " + show(value) + ")");
+    }
+    if (!value.is_number()) fail(field, "must be a number > 0 or \"inf\" (got " + show(value) + ")");
+    return positive(value, field);
+  }
+
+  const json& array(const json& value, const std::string& field) const {
+    if (!value.is_array()) fail(field, "must be an array (got " + show(value) + ")");
+    return value;
+  }
+
+ private:
+  std::string source_;
+};
+
+std::string item(const std::string& field, std::size_t index) {
+  return field + "[" + std::to_string(index) + "]";
+}
+
+void resize_particles(Particles& particles, Eigen::Index n) {
+  particles.x.setZero(3, n);
+  particles.v.setZero(3, n);
+  particles.inv_mass.setZero(n);
+}
+
+void read_particles(const Reader& reader, const json& list, Scene& scene) {
+  reader.array(list, "particles");
+  resize_particles(scene.particles, static_cast<Eigen::Index>(list.size()));
+  for (std::size_t p = 0; p < list.size(); ++p) {
+    const std::string field = item("particles", p);
+    const json& entry = list[p];
+    reader.require_object(entry, field);
+    reader.check_keys(entry, {"x", "v", "mass", "pinned"}, field);
+    if (!entry.contains("x")) reader.fail(field + ".x", "missing (every particle needs a position)");
+    const auto n = static_cast<Eigen::Index>(p);
+    scene.particles.x.col(n) = reader.vec3(entry["x"], field + ".x");
+    if (entry.contains("v")) scene.particles.v.col(n) = reader.vec3(entry["v"], field + ".v");
+    const double mass = entry.contains("mass") ? reader.positive(entry["mass"], field + ".mass") : 1.0;
+    const bool pinned = entry.contains("pinned") && reader.boolean(entry["pinned"], field + ".pinned");
+    scene.particles.inv_mass[n] = pinned ? 0.0 : 1.0 / mass;
+  }
+}
+
+void read_springs(const Reader& reader, const json& list, Scene& scene) {
+  reader.array(list, "springs");
+  const Eigen::Index n = scene.particles.size();
+  for (std::size_t s = 0; s < list.size(); ++s) {
+    const std::string field = item("springs", s);
+    const json& entry = list[s];
+    reader.require_object(entry, field);
+    reader.check_keys(entry, {"i", "j", "rest", "stiffness"}, field);
+    if (!entry.contains("i")) reader.fail(field + ".i", "missing");
+    if (!entry.contains("j")) reader.fail(field + ".j", "missing");
+    Spring spring;
+    spring.i = reader.index(entry["i"], field + ".i", n);
+    spring.j = reader.index(entry["j"], field + ".j", n);
+    if (spring.i == spring.j) reader.fail(field, "i and j must differ (both " + std::to_string(spring.i) + ")");
+    spring.rest_length = entry.contains("rest")
+                             ? reader.non_negative(entry["rest"], field + ".rest")
+                             : (scene.particles.x.col(spring.i) - scene.particles.x.col(spring.j)).norm();
+    if (entry.contains("stiffness")) spring.stiffness = reader.stiffness(entry["stiffness"], field + ".stiffness");
+    scene.springs.push_back(spring);
+  }
+}
+
+double triangle_area(const Eigen::Matrix3Xd& x, int i, int j, int k) {
+  const Eigen::Vector3d e1 = x.col(j) - x.col(i);
+  const Eigen::Vector3d e2 = x.col(k) - x.col(i);
+  return 0.5 * e1.cross(e2).norm();
+}
+
+// Zero area up to round-off, relative to the triangle's size.
+bool degenerate_area(const Eigen::Matrix3Xd& x, int i, int j, int k, double area) {
+  const double longest = std::max({(x.col(i) - x.col(j)).squaredNorm(),
+                                   (x.col(j) - x.col(k)).squaredNorm(),
+                                   (x.col(k) - x.col(i)).squaredNorm()});
+  return !(area > 1e-12 * longest);
+}
+
+void read_triangles(const Reader& reader, const json& list, Scene& scene) {
+  reader.array(list, "triangles");
+  const Eigen::Index n = scene.particles.size();
+  for (std::size_t t = 0; t < list.size(); ++t) {
+    const std::string field = item("triangles", t);
+    const json& entry = list[t];
+    reader.require_object(entry, field);
+    reader.check_keys(entry, {"i", "j", "k"}, field);
+    Triangle triangle;
+    for (const char* key : {"i", "j", "k"}) {
+      if (!entry.contains(key)) reader.fail(field + "." + key, "missing");
+    }
+    triangle.i = reader.index(entry["i"], field + ".i", n);
+    triangle.j = reader.index(entry["j"], field + ".j", n);
+    triangle.k = reader.index(entry["k"], field + ".k", n);
+    if (triangle.i == triangle.j || triangle.j == triangle.k || triangle.k == triangle.i) {
+      reader.fail(field, "repeated particle index (" + std::to_string(triangle.i) + ", " +
+                             std::to_string(triangle.j) + ", " + std::to_string(triangle.k) + ")");
+    }
+    triangle.rest_area = triangle_area(scene.particles.x, triangle.i, triangle.j, triangle.k);
+    if (degenerate_area(scene.particles.x, triangle.i, triangle.j, triangle.k, triangle.rest_area)) {
+      reader.fail(field, "zero rest area (its three particles are collinear or coincident)");
+    }
+    scene.triangles.push_back(triangle);
+  }
+}
+
+void add_spring(Scene& scene, int i, int j, double stiffness) {
+  const double rest = (scene.particles.x.col(i) - scene.particles.x.col(j)).norm();
+  scene.springs.push_back(Spring{i, j, rest, stiffness});
+}
+
+void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
+  const std::string field = "cloth";
+  reader.require_object(cloth, field);
+  reader.check_keys(cloth, {"nx", "ny", "width", "height", "mass", "pin", "springs", "stiffness",
+                            "plane", "triangles"},
+                    field);
+  auto get = [&](const char* key) -> const json* { return cloth.contains(key) ? &cloth[key] : nullptr; };
+  const int nx = get("nx") ? reader.integer_at_least(*get("nx"), "cloth.nx", 2, 4096) : 16;
+  const int ny = get("ny") ? reader.integer_at_least(*get("ny"), "cloth.ny", 2, 4096) : nx;
+  const double width = get("width") ? reader.positive(*get("width"), "cloth.width") : 1.0;
+  const double height = get("height") ? reader.positive(*get("height"), "cloth.height") : 1.0;
+  const double mass = get("mass") ? reader.positive(*get("mass"), "cloth.mass") : 1.0;
+  const double stiffness = get("stiffness") ? reader.stiffness(*get("stiffness"), "cloth.stiffness")
+                                            : kInfiniteStiffness;
+  const std::string plane = get("plane") ? reader.one_of(*get("plane"), "cloth.plane", {"xy", "xz"}) : "xy";
+  const bool with_triangles = get("triangles") ? reader.boolean(*get("triangles"), "cloth.triangles") : true;
+
+  const Eigen::Index count = static_cast<Eigen::Index>(nx) * ny;
+  resize_particles(scene.particles, count);
+  scene.particles.inv_mass.setConstant(static_cast<double>(count) / mass);
+  auto id = [nx](int row, int col) { return row * nx + col; };
+  // Row 0 is the top edge (largest y, or largest z in the xz plane), column 0 the left.
+  for (int row = 0; row < ny; ++row) {
+    for (int col = 0; col < nx; ++col) {
+      const double across = -0.5 * width + width * col / (nx - 1);
+      const double up = height * (ny - 1 - row) / (ny - 1);
+      scene.particles.x.col(id(row, col)) =
+          plane == "xy" ? Eigen::Vector3d(across, up, 0.0) : Eigen::Vector3d(across, 0.0, up);
+    }
+  }
+  scene.grid_nx = nx;
+  scene.grid_ny = ny;
+
+  if (get("pin")) {
+    const json& pins = reader.array(*get("pin"), "cloth.pin");
+    for (std::size_t p = 0; p < pins.size(); ++p) {
+      const std::string where = reader.one_of(
+          pins[p], item("cloth.pin", p), {"top-left", "top-right", "bottom-left", "bottom-right", "top"});
+      if (where == "top") {
+        for (int col = 0; col < nx; ++col) scene.particles.inv_mass[id(0, col)] = 0.0;
+      } else {
+        const int row = where.rfind("top", 0) == 0 ? 0 : ny - 1;
+        const int col = where.find("left") != std::string::npos ? 0 : nx - 1;
+        scene.particles.inv_mass[id(row, col)] = 0.0;
+      }
+    }
+  }
+
+  std::vector<std::string> kinds{"structural", "shear"};
+  if (get("springs")) {
+    kinds.clear();
+    const json& list = reader.array(*get("springs"), "cloth.springs");
+    for (std::size_t s = 0; s < list.size(); ++s) {
+      kinds.push_back(reader.one_of(list[s], item("cloth.springs", s), {"structural", "shear", "bending"}));
+    }
+  }
+  auto wants = [&](const char* kind) { return std::find(kinds.begin(), kinds.end(), kind) != kinds.end(); };
+  for (int row = 0; row < ny; ++row) {
+    for (int col = 0; col < nx; ++col) {
+      if (wants("structural")) {
+        if (col + 1 < nx) add_spring(scene, id(row, col), id(row, col + 1), stiffness);
+        if (row + 1 < ny) add_spring(scene, id(row, col), id(row + 1, col), stiffness);
+      }
+      if (wants("shear") && col + 1 < nx && row + 1 < ny) {
+        add_spring(scene, id(row, col), id(row + 1, col + 1), stiffness);
+        add_spring(scene, id(row, col + 1), id(row + 1, col), stiffness);
+      }
+      if (wants("bending")) {
+        if (col + 2 < nx) add_spring(scene, id(row, col), id(row, col + 2), stiffness);
+        if (row + 2 < ny) add_spring(scene, id(row, col), id(row + 2, col), stiffness);
+      }
+    }
+  }
+  if (with_triangles) {
+    for (int row = 0; row + 1 < ny; ++row) {
+      for (int col = 0; col + 1 < nx; ++col) {
+        const int a = id(row, col), b = id(row, col + 1), c = id(row + 1, col), d = id(row + 1, col + 1);
+        for (const auto& [i, j, k] : {std::array<int, 3>{a, c, b}, std::array<int, 3>{b, c, d}}) {
+          scene.triangles.push_back(Triangle{i, j, k, triangle_area(scene.particles.x, i, j, k)});
+        }
+      }
+    }
+  }
+}
+
+void generate_chain(const Reader& reader, const json& chain, Scene& scene) {
+  reader.require_object(chain, "chain");
+  reader.check_keys(chain, {"links", "length", "mass", "direction", "origin", "pin", "stiffness"}, "chain");
+  auto get = [&](const char* key) -> const json* { return chain.contains(key) ? &chain[key] : nullptr; };
+  const int links = get("links") ? reader.integer_at_least(*get("links"), "chain.links", 1) : 10;
+  const double length = get("length") ? reader.positive(*get("length"), "chain.length") : 1.0;
+  const double mass = get("mass") ? reader.positive(*get("mass"), "chain.mass") : 1.0;
+  Eigen::Vector3d direction(1.0, 0.0, 0.0);
+  if (get("direction")) {
+    direction = reader.vec3(*get("direction"), "chain.direction");
+    if (!(direction.norm() > 0.0)) reader.fail("chain.direction", "must not be the zero vector");
+    direction.normalize();
+  }
+  const Eigen::Vector3d origin = get("origin") ? reader.vec3(*get("origin"), "chain.origin") : Eigen::Vector3d::Zero();
+  const std::string pin = get("pin") ? reader.one_of(*get("pin"), "chain.pin", {"first", "last", "both", "none"}) : "first";
+  const double stiffness = get("stiffness") ? reader.stiffness(*get("stiffness"), "chain.stiffness") : kInfiniteStiffness;
+
+  resize_particles(scene.particles, links + 1);
+  scene.particles.inv_mass.setConstant(1.0 / mass);
+  for (int p = 0; p <= links; ++p) scene.particles.x.col(p) = origin + (length * p) * direction;
+  if (pin == "first" || pin == "both") scene.particles.inv_mass[0] = 0.0;
+  if (pin == "last" || pin == "both") scene.particles.inv_mass[links] = 0.0;
+  for (int p = 0; p < links; ++p) scene.springs.push_back(Spring{p, p + 1, length, stiffness});
+}
+
+// Deterministic, platform-independent uniform numbers in [-1, 1) (splitmix64).
+double next_symmetric(std::uint64_t& state) {
+  std::uint64_t z = (state += 0x9E3779B97F4A7C15ULL);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  z ^= z >> 31;
+  return 2.0 * static_cast<double>(z >> 11) * 0x1.0p-53 - 1.0;
+}
+
+void apply_jitter(const Reader& reader, const json& jitter, Scene& scene) {
+  reader.require_object(jitter, "jitter");
+  reader.check_keys(jitter, {"amplitude", "seed"}, "jitter");
+  const double amplitude = jitter.contains("amplitude") ? reader.non_negative(jitter["amplitude"], "jitter.amplitude") : 0.0;
+  std::uint64_t state = jitter.contains("seed")
+                            ? static_cast<std::uint64_t>(reader.integer_at_least(jitter["seed"], "jitter.seed", 0, 2'000'000'000))
+                            : 1u;
+  for (Eigen::Index p = 0; p < scene.particles.size(); ++p) {
+    for (int axis = 0; axis < 3; ++axis) {
+      const double offset = amplitude * next_symmetric(state);
+      if (scene.particles.inv_mass[p] > 0.0) scene.particles.x(axis, p) += offset;
+    }
+  }
+}
+
+// Builds the document like nlohmann's own parser while tracking where it is,
+// so that a number too large for a double (JSON has no inf) is reported with
+// its field and index like every other rejection.
+class TrackingBuilder : public nlohmann::json_sax<json> {
+ public:
+  TrackingBuilder(json& root, std::string source) : dom_(root, false), source_(std::move(source)) {}
+
+  bool null() override { return value(dom_.null()); }
+  bool boolean(bool v) override { return value(dom_.boolean(v)); }
+  bool number_integer(number_integer_t v) override { return value(dom_.number_integer(v)); }
+  bool number_unsigned(number_unsigned_t v) override { return value(dom_.number_unsigned(v)); }
+  bool number_float(number_float_t v, const string_t& s) override { return value(dom_.number_float(v, s)); }
+  bool string(string_t& v) override { return value(dom_.string(v)); }
+  bool binary(binary_t& v) override { return value(dom_.binary(v)); }
+  bool start_object(std::size_t n) override { return open(false) && dom_.start_object(n); }
+  bool key(string_t& k) override {
+    path_.back().key = k;
+    return dom_.key(k);
+  }
+  bool end_object() override { return close() && dom_.end_object(); }
+  bool start_array(std::size_t n) override { return open(true) && dom_.start_array(n); }
+  bool end_array() override { return close() && dom_.end_array(); }
+  bool parse_error(std::size_t position, const std::string& token, const nlohmann::detail::exception& error) override {
+    if (error.id == 406) {  // number overflow: the value was read, so the path is known
+      throw InputError(source_ + ": " + here() + ": must be finite (got " + token + ")");
+    }
+    std::string what = error.what();
+    const std::size_t at = what.find("] ");
+    if (at != std::string::npos) what = what.substr(at + 2);
+    (void)position;
+    throw InputError(source_ + ": malformed JSON: " + what);
+  }
+
+ private:
+  struct Level {
+    bool array = false;
+    long index = -1;
+    std::string key;
+  };
+
+  bool open(bool array) {
+    before_value();
+    path_.push_back(Level{array, -1, {}});
+    return true;
+  }
+  bool close() {
+    path_.pop_back();
+    return true;
+  }
+  void before_value() {
+    if (!path_.empty() && path_.back().array) ++path_.back().index;
+  }
+  bool value(bool accepted) {
+    before_value();
+    return accepted;
+  }
+  // The field being read, in the form the other messages use: "particles[3].x[2]".
+  std::string here() const {
+    // The failing number was never counted, so the innermost array is one behind.
+    std::string field;
+    for (std::size_t depth = 0; depth < path_.size(); ++depth) {
+      const Level& level = path_[depth];
+      if (level.array) {
+        field += "[" + std::to_string(level.index + (depth + 1 == path_.size() ? 1 : 0)) + "]";
+      } else if (!level.key.empty()) {
+        field += (field.empty() ? "" : ".") + level.key;
+      }
+    }
+    return field.empty() ? "(top level)" : field;
+  }
+
+  nlohmann::detail::json_sax_dom_parser<json> dom_;
+  std::string source_;
+  std::vector<Level> path_;
+};
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& source) {
+  json root;
+  TrackingBuilder builder(root, source);
+  json::sax_parse(text, &builder, json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true);
+  const Reader reader(source);
+  reader.require_object(root, "(top level)");
+  reader.check_keys(root, {"name", "description", "gravity", "dt", "steps", "particles", "springs",
+                           "triangles", "cloth", "chain", "jitter"},
+                    "");
+
+  Scene scene;
+  scene.source = source;
+  scene.name = root.contains("name") ? reader.string(root["name"], "name") : fs::path(source).stem().string();
+  if (root.contains("description")) reader.string(root["description"], "description");
+  if (root.contains("gravity")) scene.gravity = reader.vec3(root["gravity"], "gravity");
+  if (root.contains("dt")) scene.dt = reader.positive(root["dt"], "dt");
+  if (root.contains("steps")) scene.steps = reader.integer_at_least(root["steps"], "steps", 0);
+
+  const int sources = static_cast<int>(root.contains("particles")) + static_cast<int>(root.contains("cloth")) +
+                      static_cast<int>(root.contains("chain"));
+  if (sources != 1) {
+    reader.fail("particles", "a scene needs exactly one of \"particles\", \"cloth\" or \"chain\" (found " +
+                                 std::to_string(sources) + ")");
+  }
+  if (root.contains("particles")) {
+    read_particles(reader, root["particles"], scene);
+    if (root.contains("springs")) read_springs(reader, root["springs"], scene);
+    if (root.contains("triangles")) read_triangles(reader, root["triangles"], scene);
+  } else {
+    for (const char* key : {"springs", "triangles"}) {
+      if (root.contains(key)) reader.fail(key, "not allowed with a generator (it makes its own)");
+    }
+    if (root.contains("cloth")) generate_cloth(reader, root["cloth"], scene);
+    if (root.contains("chain")) generate_chain(reader, root["chain"], scene);
+  }
+  if (root.contains("jitter")) apply_jitter(reader, root["jitter"], scene);
+  return scene;
+}
+
+Scene load_scene(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(path + ": cannot open scene file");
+  std::ostringstream text;
+  text << file.rdbuf();
+  return parse_scene(text.str(), path);
+}
+
+std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir) {
+  std::error_code error;
+  const bool looks_like_path = name_or_path.find('/') != std::string::npos ||
+                               (name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".json");
+  if (looks_like_path || fs::is_regular_file(name_or_path, error)) return name_or_path;
+
+  std::vector<fs::path> places{fs::path(lab_scene_dir)};
+  const fs::path labs = fs::path(CL_SOURCE_DIR) / "labs";
+  if (fs::is_directory(labs, error)) {
+    std::vector<fs::path> lab_dirs;
+    for (const auto& entry : fs::directory_iterator(labs, error)) lab_dirs.push_back(entry.path() / "scenes");
+    std::sort(lab_dirs.begin(), lab_dirs.end());
+    places.insert(places.end(), lab_dirs.begin(), lab_dirs.end());
+  }
+  for (const fs::path& place : places) {
+    const fs::path candidate = place / (name_or_path + ".json");
+    if (fs::is_regular_file(candidate, error)) return candidate.string();
+  }
+  std::string known;
+  for (const std::string& name : list_scene_names(lab_scene_dir)) known += (known.empty() ? "" : ", ") + name;
+  throw InputError("--scene: no scene named '" + name_or_path + "' (this lab ships: " + known + ")");
+}
+
+std::vector<std::string> list_scene_names(const std::string& scene_dir) {
+  std::vector<std::string> names;
+  std::error_code error;
+  if (!fs::is_directory(scene_dir, error)) return names;
+  for (const auto& entry : fs::directory_iterator(scene_dir, error)) {
+    if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace cl

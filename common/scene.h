@@ -1,0 +1,50 @@
+#pragma once
+// Scenes: the JSON format of COURSE.md §3, with strict validation.
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/constraints.h"
+#include "common/particles.h"
+
+namespace cl {
+
+// Bad input: the message is one line naming the file, the field and the index,
+// e.g. "scenes/bad.json: particles[3].mass: must be > 0 (got -1)".
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Scene {
+  std::string name;
+  std::string source;                       // file the scene came from
+  Eigen::Vector3d gravity{0.0, -9.81, 0.0};  // m/s²
+  double dt = 1.0 / 60.0;                   // s
+  int steps = 120;
+  Particles particles;
+  std::vector<Spring> springs;       // empty unless the scene declares springs
+  std::vector<Triangle> triangles;   // empty unless the scene declares triangles
+  // Generator layout for drawing: a cloth's grid size (0 x 0 otherwise).
+  int grid_nx = 0;
+  int grid_ny = 0;
+};
+
+// Parses scene text; `source` names the file in error messages. Throws InputError.
+Scene parse_scene(const std::string& text, const std::string& source);
+
+// Reads and parses a scene file. Throws InputError.
+Scene load_scene(const std::string& path);
+
+// Resolves --scene: an argument that names an existing file or ends in .json is
+// a path; otherwise it is a scene name looked up as NAME.json in lab_scene_dir,
+// then in every lab's scenes/. Throws InputError naming the places searched.
+std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir);
+
+// Every scene name shipped in a scenes directory, sorted.
+std::vector<std::string> list_scene_names(const std::string& scene_dir);
+
+}  // namespace cl

@@ -1,0 +1,116 @@
+// Every rejection rule of COURSE.md §3, run through a real lab executable:
+// exit code 2, one stderr line naming the file and the field, no output left.
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+
+using Catch::Matchers::Contains;
+using Catch::Matchers::StartsWith;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct RunResult {
+  int exit_code = -1;
+  std::string stderr_text;
+};
+
+std::string read(const fs::path& path) {
+  std::ifstream file(path);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+RunResult run_probe(const std::string& arguments, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string command = std::string("'") + CL_PROBE_EXE + "' " + arguments + " > /dev/null 2> '" +
+                              err.string() + "'";
+  const int status = std::system(command.c_str());
+  RunResult result;
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.stderr_text = read(err);
+  return result;
+}
+
+// Runs the probe on a scene with `text`, asking for CSV and summary output.
+RunResult run_scene(const std::string& text, const fs::path& dir) {
+  fs::create_directories(dir);
+  std::ofstream(dir / "bad.json") << text;
+  return run_probe("--scene '" + (dir / "bad.json").string() + "' --out '" + (dir / "out").string() +
+                       "' --summary '" + (dir / "out" / "summary.json").string() + "'",
+                   dir);
+}
+
+const char* const kTwo = R"("particles": [{"x": [0,0,0]}, {"x": [1,0,0]}])";
+const char* const kThree = R"("particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [2,0,0]}])";
+
+}  // namespace
+
+TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad-input]") {
+  struct Rule {
+    const char* what;
+    std::string text;
+    const char* field;
+  };
+  const std::vector<Rule> rules{
+      {"malformed JSON", R"({"particles": [)", "malformed JSON"},
+      {"unknown key", std::string("{") + kTwo + R"(, "colour": "red"})", "colour"},
+      {"unknown particle key", R"({"particles": [{"x": [0,0,0], "m": 1}]})", "particles[0].m"},
+      {"missing x", R"({"particles": [{"x": [0,0,0]}, {"mass": 1}]})", "particles[1].x"},
+      {"non-finite number", R"({"particles": [{"x": [0,0,1e400]}]})", "particles[0].x[2]"},
+      {"mass zero", R"({"particles": [{"x": [0,0,0], "mass": 0}]})", "particles[0].mass"},
+      {"mass negative", R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0], "mass": -2}]})", "particles[1].mass"},
+      {"rest negative", std::string("{") + kTwo + R"(, "springs": [{"i": 0, "j": 1, "rest": -1}]})",
+       "springs[0].rest"},
+      {"index out of range", std::string("{") + kTwo + R"(, "springs": [{"i": 0, "j": 1}, {"i": 0, "j": 7}]})",
+       "springs[1].j"},
+      {"index not an integer", std::string("{") + kTwo + R"(, "springs": [{"i": "0", "j": 1}]})", "springs[0].i"},
+      {"index fractional", std::string("{") + kTwo + R"(, "springs": [{"i": 0, "j": 1.5}]})", "springs[0].j"},
+      {"i == j", std::string("{") + kTwo + R"(, "springs": [{"i": 1, "j": 1}]})", "springs[0]"},
+      {"triangle repeated index", std::string("{") + kThree + R"(, "triangles": [{"i": 0, "j": 2, "k": 2}]})",
+       "triangles[0]"},
+      {"triangle zero rest area", std::string("{") + kThree + R"(, "triangles": [{"i": 0, "j": 1, "k": 2}]})",
+       "triangles[0]"},
+      {"stiffness zero", std::string("{") + kTwo + R"(, "springs": [{"i": 0, "j": 1, "stiffness": 0}]})",
+       "springs[0].stiffness"},
+      {"stiffness negative", R"({"chain": {"links": 2, "stiffness": -5}})", "chain.stiffness"},
+      {"cloth unknown pin", R"({"cloth": {"nx": 4, "pin": ["centre"]}})", "cloth.pin[0]"},
+  };
+  int index = 0;
+  for (const Rule& rule : rules) {
+    const fs::path dir = fs::temp_directory_path() / ("cl_bad_input_" + std::to_string(index++));
+    fs::remove_all(dir);
+    CAPTURE(rule.what, rule.text);
+    const RunResult result = run_scene(rule.text, dir);
+    CAPTURE(result.stderr_text);
+    CHECK(result.exit_code == 2);
+    CHECK_THAT(result.stderr_text, Contains((dir / "bad.json").string()));
+    CHECK_THAT(result.stderr_text, Contains(rule.field));
+    CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
+    CHECK_FALSE(fs::exists(dir / "out"));
+    fs::remove_all(dir);
+  }
+}
+
+TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
+  const fs::path dir = fs::temp_directory_path() / "cl_bad_cli";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* arguments : {"--no-such-flag", "--scene no-such-scene", "--scene /no/such/file.json",
+                                "--scene"}) {
+    CAPTURE(arguments);
+    const RunResult result = run_probe(arguments, dir);
+    CAPTURE(result.stderr_text);
+    CHECK(result.exit_code == 2);
+    CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
+    CHECK_THAT(result.stderr_text, StartsWith("lab01_single_spring"));
+  }
+  fs::remove_all(dir);
+}

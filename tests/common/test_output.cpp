@@ -1,0 +1,66 @@
+// CSV, summary and atomic file output.
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include "common/csv.h"
+#include "common/output.h"
+#include "common/summary.h"
+
+namespace {
+std::string read(const std::filesystem::path& path) {
+  std::ifstream file(path);
+  std::ostringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("cl_test_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+}  // namespace
+
+TEST_CASE("doubles are written so that they read back exactly", "[common][output]") {
+  for (double value : {0.1, 1.0 / 3.0, -2.5e-300, 6.02214076e23}) {
+    CAPTURE(value);
+    CHECK(std::stod(cl::format_double(value)) == value);
+  }
+}
+
+TEST_CASE("a CSV table is written whole into a new directory", "[common][output]") {
+  const std::filesystem::path dir = fresh_dir("csv");
+  cl::CsvTable table({"a", "b", "c"});
+  table.add_row({0.1, 2LL, std::string("x")});
+  CHECK_THROWS_AS(table.add_row({1.0}), std::invalid_argument);
+  table.write((dir / "sub" / "t.csv").string());
+  CHECK(read(dir / "sub" / "t.csv") == "a,b,c\n0.10000000000000001,2,x\n");
+  CHECK_FALSE(std::filesystem::exists(dir / "sub" / "t.csv.part"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("the run summary has the contract's keys and exact positions", "[common][output]") {
+  const std::filesystem::path dir = fresh_dir("summary");
+  cl::RunSummary summary;
+  summary.lab = "lab01_single_spring";
+  summary.method = "single-pass";
+  summary.scene = "s";
+  summary.positions = Eigen::Matrix3Xd::Constant(3, 2, 0.1);
+  summary.positions(2, 1) = 1.0 / 3.0;
+  summary.max_strain_error = 1e-17;
+  summary.seconds = 0.5;
+  summary.extra["rms_strain_error"] = 0.0;
+  cl::write_summary((dir / "s.json").string(), summary);
+  const nlohmann::json parsed = nlohmann::json::parse(read(dir / "s.json"));
+  CHECK(parsed["lab"] == "lab01_single_spring");
+  CHECK(parsed["positions"][1][2].get<double>() == 1.0 / 3.0);
+  CHECK(parsed["max_strain_error"].get<double>() == 1e-17);
+  CHECK(parsed.contains("rms_strain_error"));
+  CHECK_FALSE(parsed.contains("velocities"));
+  CHECK_FALSE(parsed.contains("dt"));
+  std::filesystem::remove_all(dir);
+}

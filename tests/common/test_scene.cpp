@@ -1,0 +1,125 @@
+// Scene loading: defaults, generators, and that each rejection names its field.
+#include <catch2/catch.hpp>
+
+#include "common/scene.h"
+
+using Catch::Matchers::Contains;
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+
+namespace {
+cl::Scene parse(const std::string& text) { return cl::parse_scene(text, "test.json"); }
+
+std::string rejection(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const cl::InputError& error) {
+    return error.what();
+  }
+  return "(accepted)";
+}
+}  // namespace
+
+TEST_CASE("explicit particles and springs with their defaults", "[common][scene]") {
+  const cl::Scene scene = parse(R"({
+    // comments are allowed
+    "name": "two",
+    "particles": [{"x": [0, 0, 0], "pinned": true}, {"x": [2, 0, 0], "v": [0, 1, 0], "mass": 4}],
+    "springs": [{"i": 0, "j": 1}, {"i": 1, "j": 0, "rest": 0.5, "stiffness": 100}]
+  })");
+  CHECK(scene.name == "two");
+  CHECK(scene.gravity == Eigen::Vector3d(0, -9.81, 0));
+  CHECK_THAT(scene.dt, WithinRel(1.0 / 60.0, 1e-15));
+  REQUIRE(scene.particles.size() == 2);
+  CHECK(scene.particles.inv_mass[0] == 0.0);
+  CHECK(scene.particles.inv_mass[1] == 0.25);
+  CHECK(scene.particles.v.col(1) == Eigen::Vector3d(0, 1, 0));
+  REQUIRE(scene.springs.size() == 2);
+  CHECK(scene.springs[0].rest_length == 2.0);
+  CHECK(std::isinf(scene.springs[0].stiffness));
+  CHECK(scene.springs[1].rest_length == 0.5);
+  CHECK(scene.springs[1].stiffness == 100.0);
+  CHECK(scene.triangles.empty());
+}
+
+TEST_CASE("the chain generator", "[common][scene]") {
+  const cl::Scene scene = parse(R"({"chain": {"links": 4, "length": 0.5, "mass": 2,
+                                             "direction": [0, -2, 0], "pin": "both"}})");
+  REQUIRE(scene.particles.size() == 5);
+  REQUIRE(scene.springs.size() == 4);
+  CHECK(scene.particles.x.col(4).isApprox(Eigen::Vector3d(0, -2, 0)));
+  CHECK(scene.particles.inv_mass[0] == 0.0);
+  CHECK(scene.particles.inv_mass[4] == 0.0);
+  CHECK(scene.particles.inv_mass[2] == 0.5);
+  for (const cl::Spring& spring : scene.springs) CHECK(spring.rest_length == 0.5);
+  CHECK(scene.triangles.empty());
+}
+
+TEST_CASE("the cloth generator", "[common][scene]") {
+  for (int n : {2, 3, 8}) {
+    CAPTURE(n);
+    const std::string text = R"({"cloth": {"nx": )" + std::to_string(n) + R"(, "ny": )" + std::to_string(n + 1) +
+                             R"(, "width": 2, "height": 1, "mass": 3, "pin": ["top-left", "top-right"],
+                                  "springs": ["structural", "shear", "bending"]}})";
+    const cl::Scene scene = parse(text);
+    const int nx = n, ny = n + 1;
+    REQUIRE(scene.particles.size() == nx * ny);
+    const auto structural = static_cast<std::size_t>((nx - 1) * ny + nx * (ny - 1));
+    const auto shear = static_cast<std::size_t>(2 * (nx - 1) * (ny - 1));
+    const auto bending = static_cast<std::size_t>(std::max(nx - 2, 0) * ny + nx * std::max(ny - 2, 0));
+    CHECK(scene.springs.size() == structural + shear + bending);
+    CHECK(scene.triangles.size() == static_cast<std::size_t>(2 * (nx - 1) * (ny - 1)));
+    // Total mass 3, spread evenly; the top corners pinned; top = largest y.
+    CHECK_THAT(scene.particles.inv_mass[nx], WithinRel(nx * ny / 3.0, 1e-14));
+    CHECK(scene.particles.inv_mass[0] == 0.0);
+    CHECK(scene.particles.inv_mass[nx - 1] == 0.0);
+    CHECK(scene.particles.x(1, 0) == scene.particles.x.row(1).maxCoeff());
+    double area = 0.0;
+    for (const cl::Triangle& triangle : scene.triangles) area += triangle.rest_area;
+    CHECK_THAT(area, WithinRel(2.0, 1e-12));
+  }
+  const cl::Scene flat = parse(R"({"cloth": {"nx": 3, "plane": "xz", "triangles": false}})");
+  CHECK(flat.particles.x.row(1).isZero(0.0));
+  CHECK(flat.triangles.empty());
+}
+
+TEST_CASE("jitter moves only free particles and keeps generated rest lengths", "[common][scene]") {
+  const cl::Scene scene = parse(R"({"chain": {"links": 3}, "jitter": {"amplitude": 0.1, "seed": 5}})");
+  CHECK(scene.particles.x.col(0) == Eigen::Vector3d::Zero());
+  CHECK((scene.particles.x.col(1) - Eigen::Vector3d(1, 0, 0)).norm() > 0.0);
+  CHECK((scene.particles.x.col(1) - Eigen::Vector3d(1, 0, 0)).cwiseAbs().maxCoeff() <= 0.1);
+  CHECK(scene.springs[0].rest_length == 1.0);
+  const cl::Scene again = parse(R"({"chain": {"links": 3}, "jitter": {"amplitude": 0.1, "seed": 5}})");
+  CHECK(again.particles.x == scene.particles.x);
+}
+
+TEST_CASE("each rejection names the field and index", "[common][scene]") {
+  CHECK_THAT(rejection("{"), Contains("test.json: malformed JSON"));
+  CHECK_THAT(rejection(R"({"particles": [], "colour": 1})"), Contains("colour: unknown key"));
+  CHECK_THAT(rejection(R"({"particles": [{"v": [0,0,0]}]})"), Contains("particles[0].x: missing"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [0,0,0], "mass": 0}]})"),
+             Contains("particles[1].mass: must be > 0"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,1e999,0]}]})"), Contains("particles[0].x[1]"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 2}]})"),
+             Contains("springs[0].j: index out of range"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0.5, "j": 1}]})"),
+             Contains("springs[0].i: must be an integer"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 1, "j": 1}]})"),
+             Contains("springs[0]: i and j must differ"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": -1}]})"),
+             Contains("springs[0].rest: must be >= 0"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "stiffness": 0}]})"),
+             Contains("springs[0].stiffness: must be > 0"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [2,0,0]}], "triangles": [{"i": 0, "j": 1, "k": 2}]})"),
+             Contains("triangles[0]: zero rest area"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [0,1,0]}], "triangles": [{"i": 0, "j": 1, "k": 0}]})"),
+             Contains("triangles[0]: repeated particle index"));
+  CHECK_THAT(rejection(R"({"chain": {"links": 0}})"), Contains("chain.links"));
+  CHECK_THAT(rejection(R"({"cloth": {"pin": ["middle"]}})"), Contains("cloth.pin[0]: must be one of"));
+  CHECK_THAT(rejection(R"({"chain": {}, "cloth": {}})"), Contains("exactly one of"));
+}
+
+TEST_CASE("rest length 0 is allowed", "[common][scene]") {
+  const cl::Scene scene = parse(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": 0}]})");
+  CHECK(scene.springs[0].rest_length == 0.0);
+}

@@ -1,0 +1,144 @@
+// Graded tests for lab01.1, project_distance. Properties and analytic cases.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+
+#include "single_spring.h"
+
+using Catch::Matchers::WithinAbs;
+using Catch::Matchers::WithinRel;
+using cl::lab01::DistanceCorrection;
+using cl::lab01::project_distance;
+using Eigen::Vector3d;
+
+namespace {
+
+struct Case {
+  Vector3d x_i, x_j;
+  double inv_mass_i, inv_mass_j, rest_length;
+};
+
+// Random configurations: positions in a box of size `scale`, rest lengths from
+// 0.1 to 3 times the current distance, inverse masses from 1e-2 to 1e2.
+std::vector<Case> random_cases(unsigned seed, double scale, int count) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_real_distribution<double> log_mass(-2.0, 2.0);
+  std::uniform_real_distribution<double> stretch(0.1, 3.0);
+  std::vector<Case> cases;
+  for (int c = 0; c < count; ++c) {
+    Case item;
+    item.x_i = scale * Vector3d(unit(rng), unit(rng), unit(rng));
+    item.x_j = scale * Vector3d(unit(rng), unit(rng), unit(rng));
+    item.inv_mass_i = std::pow(10.0, log_mass(rng));
+    item.inv_mass_j = std::pow(10.0, log_mass(rng));
+    item.rest_length = stretch(rng) * (item.x_i - item.x_j).norm();
+    cases.push_back(item);
+  }
+  return cases;
+}
+
+double projected_length(const Case& item, const DistanceCorrection& correction) {
+  return ((item.x_i + correction.dx_i) - (item.x_j + correction.dx_j)).norm();
+}
+
+void check_exact_length(double scale) {
+  for (const Case& item : random_cases(7, scale, 200)) {
+    CAPTURE(scale, item.x_i.transpose(), item.x_j.transpose(), item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    const DistanceCorrection correction =
+        project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    REQUIRE_THAT(projected_length(item, correction), WithinRel(item.rest_length, 1e-12));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("one projection restores the rest length exactly", "[lab01][pts=2]") {
+  check_exact_length(1.0);
+}
+
+TEST_CASE("the correction splits by inverse mass along the constraint", "[lab01][pts=1]") {
+  for (const Case& item : random_cases(11, 1.0, 100)) {
+    CAPTURE(item.x_i.transpose(), item.x_j.transpose(), item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    const DistanceCorrection correction =
+        project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    const double share_i = correction.dx_i.norm() / (correction.dx_i.norm() + correction.dx_j.norm());
+    REQUIRE_THAT(share_i, WithinRel(item.inv_mass_i / (item.inv_mass_i + item.inv_mass_j), 1e-12));
+    // Both corrections lie along d = x_i − x_j.
+    const Vector3d d = item.x_i - item.x_j;
+    REQUIRE_THAT(d.cross(correction.dx_i).norm(), WithinAbs(0.0, 1e-12 * d.norm() * correction.dx_i.norm()));
+    REQUIRE_THAT(d.cross(correction.dx_j).norm(), WithinAbs(0.0, 1e-12 * d.norm() * correction.dx_j.norm()));
+  }
+}
+
+TEST_CASE("linear and angular momentum are unchanged, pinned ends included", "[lab01][pts=1]") {
+  // Σ m Δx = 0 and Σ m x × Δx = 0, multiplied through by w_i w_j so that a
+  // pinned end (w = 0, infinite mass) needs no division:  w_j Δx_i + w_i Δx_j = 0.
+  std::vector<Case> cases = random_cases(13, 1.0, 100);
+  cases.push_back({Vector3d(0, 0, 0), Vector3d(2, 0, 0), 0.0, 1.0, 1.0});
+  cases.push_back({Vector3d(0, 1, 0), Vector3d(0, 3, 1), 2.0, 0.0, 0.5});
+  for (const Case& item : cases) {
+    CAPTURE(item.x_i.transpose(), item.x_j.transpose(), item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    const DistanceCorrection correction =
+        project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
+    const double size = correction.dx_i.norm() + correction.dx_j.norm();
+    REQUIRE(size > 0.0);
+    const Vector3d momentum = item.inv_mass_j * correction.dx_i + item.inv_mass_i * correction.dx_j;
+    const Vector3d angular =
+        item.inv_mass_j * item.x_i.cross(correction.dx_i) + item.inv_mass_i * item.x_j.cross(correction.dx_j);
+    const double scale = (item.inv_mass_i + item.inv_mass_j) * size;
+    REQUIRE_THAT(momentum.norm(), WithinAbs(0.0, 1e-13 * scale));
+    REQUIRE_THAT(angular.norm(), WithinAbs(0.0, 1e-13 * scale * (item.x_i.norm() + item.x_j.norm())));
+  }
+}
+
+TEST_CASE("one end pinned: the free end moves the whole way", "[lab01][pts=1]") {
+  const Vector3d anchor(0.0, 0.0, 0.0);
+  const Vector3d free_end(2.0, 0.0, 0.0);
+  SECTION("pinned first") {
+    const DistanceCorrection correction = project_distance(anchor, free_end, 0.0, 1.0 / 3.0, 1.0);
+    REQUIRE(correction.dx_i == Vector3d::Zero());
+    REQUIRE_THAT(correction.dx_j.x(), WithinRel(-1.0, 1e-15));
+    REQUIRE(correction.dx_j.y() == 0.0);
+    REQUIRE(correction.dx_j.z() == 0.0);
+  }
+  SECTION("pinned second") {
+    const DistanceCorrection correction = project_distance(free_end, anchor, 5.0, 0.0, 0.5);
+    REQUIRE(correction.dx_j == Vector3d::Zero());
+    REQUIRE_THAT(correction.dx_i.x(), WithinRel(-1.5, 1e-15));
+  }
+}
+
+TEST_CASE("both ends pinned: nothing moves", "[lab01][pts=1]") {
+  const DistanceCorrection correction =
+      project_distance(Vector3d(0, 0, 0), Vector3d(3, 4, 0), 0.0, 0.0, 1.0);
+  REQUIRE(correction.dx_i == Vector3d::Zero());
+  REQUIRE(correction.dx_j == Vector3d::Zero());
+}
+
+TEST_CASE("coincident particles: zero correction, no NaN", "[lab01][pts=1]") {
+  const Vector3d point(0.25, -1.0, 3.0);
+  for (double rest_length : {0.0, 1.0}) {
+    CAPTURE(rest_length);
+    const DistanceCorrection correction = project_distance(point, point, 1.0, 2.0, rest_length);
+    REQUIRE(correction.dx_i == Vector3d::Zero());
+    REQUIRE(correction.dx_j == Vector3d::Zero());
+  }
+}
+
+TEST_CASE("coordinates scaled by 1e6 and 1e-6 still project exactly", "[lab01][pts=1]") {
+  for (double scale : {1e-6, 1e6}) check_exact_length(scale);
+}
+
+TEST_CASE("invalid arguments throw std::invalid_argument", "[lab01][pts=1]") {
+  const Vector3d a(0, 0, 0), b(1, 0, 0);
+  REQUIRE_THROWS_AS(project_distance(a, b, -1.0, 1.0, 1.0), std::invalid_argument);
+  REQUIRE_THROWS_AS(project_distance(a, b, 1.0, -1.0, 1.0), std::invalid_argument);
+  REQUIRE_THROWS_AS(project_distance(a, b, 1.0, 1.0, -0.5), std::invalid_argument);
+  REQUIRE_THROWS_AS(project_distance(a, b, std::nan(""), 1.0, 1.0), std::invalid_argument);
+  // Rest length 0 is allowed: the ends meet.
+  const DistanceCorrection correction = project_distance(a, b, 1.0, 1.0, 0.0);
+  REQUIRE(((a + correction.dx_i) - (b + correction.dx_j)).norm() == 0.0);
+}
