@@ -1,9 +1,11 @@
-# add_lab(NAME STUDENT a.cpp [b.cpp ...] [SUPPORT s.cpp ...] [DEPENDS earlier_lab ...])
+# add_lab(NAME STUDENT a.cpp [b.cpp ...] [SUPPORT s.cpp ...] [DEPENDS earlier_lab ...]
+#         [LIBRARIES target ...])
 #
 # Files by convention, all under labs/NAME unless said otherwise:
 #   STUDENT   the student's .cpp stubs; solutions/NAME holds a reference .cpp of
 #             the same name for each
 #   SUPPORT   lab code that is not the student's (used by the driver and tests)
+#   LIBRARIES extra link targets for the lab's code (e.g. OpenMP::OpenMP_CXX)
 #   main.cpp  the executable's driver
 #   scenes/   the lab's JSON scenes
 #   tests/NAME/*.cpp  the graded tests
@@ -15,7 +17,7 @@
 #                                  labs' reference code (isolation, COURSE.md §4)
 #   NAME_tests_solution            graded tests against reference code throughout
 function(add_lab name)
-  cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS" ${ARGN})
+  cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS;LIBRARIES" ${ARGN})
   set(lab_dir "${PROJECT_SOURCE_DIR}/labs/${name}")
   set(solution_dir "${PROJECT_SOURCE_DIR}/solutions/${name}")
 
@@ -42,12 +44,12 @@ function(add_lab name)
   if(LAB_SUPPORT)
     list(TRANSFORM LAB_SUPPORT PREPEND "${lab_dir}/")
     add_library(${name}_support STATIC ${LAB_SUPPORT})
-    target_link_libraries(${name}_support PUBLIC common)
+    target_link_libraries(${name}_support PUBLIC common ${LAB_LIBRARIES})
     target_include_directories(${name}_support PUBLIC "${lab_dir}")
   else()
     add_library(${name}_support INTERFACE)
     target_include_directories(${name}_support INTERFACE "${lab_dir}")
-    target_link_libraries(${name}_support INTERFACE common)
+    target_link_libraries(${name}_support INTERFACE common ${LAB_LIBRARIES})
   endif()
 
   add_library(${name}_student STATIC ${student_sources})
@@ -58,8 +60,13 @@ function(add_lab name)
     # The reference includes the header beside the stub: one contract, no drift.
     target_include_directories(${name}_reference PRIVATE "${lab_dir}")
   endif()
+  if(LAB_SUPPORT)
+    set(scope PUBLIC)
+  else()
+    set(scope INTERFACE)
+  endif()
   foreach(dep IN LISTS closure)
-    target_include_directories(${name}_support INTERFACE "${PROJECT_SOURCE_DIR}/labs/${dep}")
+    target_include_directories(${name}_support ${scope} "${PROJECT_SOURCE_DIR}/labs/${dep}")
   endforeach()
 
   # Link lines: [support, implementation] for this lab, then for each earlier lab.
