@@ -16,6 +16,8 @@
 #   NAME_tests                     graded tests: this lab's student code, earlier
 #                                  labs' reference code (isolation, COURSE.md §4)
 #   NAME_tests_solution            graded tests against reference code throughout
+# Drivers see CL_LAB_NAME (the lab, for summaries), CL_PROGRAM_NAME (the
+# executable, for messages) and CL_LAB_SCENE_DIR (absolute path of scenes/).
 function(add_lab name)
   cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS;LIBRARIES" ${ARGN})
   set(lab_dir "${PROJECT_SOURCE_DIR}/labs/${name}")
@@ -88,7 +90,7 @@ function(add_lab name)
 
   add_executable(${name} "${lab_dir}/main.cpp")
   target_link_libraries(${name} PRIVATE ${student_chain} common)
-  target_compile_definitions(${name} PRIVATE ${scene_definition} CL_LAB_NAME="${name}")
+  target_compile_definitions(${name} PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
   file(GLOB test_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/*.cpp")
@@ -100,7 +102,7 @@ function(add_lab name)
   if(CL_HAVE_SOLUTIONS)
     add_executable(${name}_solution "${lab_dir}/main.cpp")
     target_link_libraries(${name}_solution PRIVATE ${reference_chain} common)
-    target_compile_definitions(${name}_solution PRIVATE ${scene_definition} CL_LAB_NAME="${name}")
+    target_compile_definitions(${name}_solution PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}_solution")
     set_target_properties(${name}_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
     add_executable(${name}_tests_solution ${test_sources})

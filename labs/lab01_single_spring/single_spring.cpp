@@ -6,7 +6,7 @@
 
 namespace cl::lab01 {
 
-// TODO(lab01.1) [7 pts] Project one distance constraint.
+// TODO(lab01.1) [9 pts] Project one distance constraint.
 // Compute d = x_i − x_j, its length, C = length − rest_length, and move each end
 // along n = d / length, the lighter (larger inverse mass) end further. Return
 // zeros when both ends are pinned or the particles coincide; throw

@@ -73,7 +73,7 @@ TEST_CASE("the correction splits by inverse mass along the constraint", "[lab01]
   }
 }
 
-TEST_CASE("linear and angular momentum are unchanged, pinned ends included", "[lab01][pts=1]") {
+TEST_CASE("linear and angular momentum are unchanged even with a pinned end", "[lab01][pts=1]") {
   // Σ m Δx = 0 and Σ m x × Δx = 0, multiplied through by w_i w_j so that a
   // pinned end (w = 0, infinite mass) needs no division:  w_j Δx_i + w_i Δx_j = 0.
   std::vector<Case> cases = random_cases(13, 1.0, 100);
@@ -118,7 +118,7 @@ TEST_CASE("both ends pinned: nothing moves", "[lab01][pts=1]") {
   REQUIRE(correction.dx_j == Vector3d::Zero());
 }
 
-TEST_CASE("coincident particles: zero correction, no NaN", "[lab01][pts=1]") {
+TEST_CASE("coincident particles give a zero correction and no NaN", "[lab01][pts=1]") {
   const Vector3d point(0.25, -1.0, 3.0);
   for (double rest_length : {0.0, 1.0}) {
     CAPTURE(rest_length);
