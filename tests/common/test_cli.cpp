@@ -1,0 +1,65 @@
+// The shared command line: scene lookup and the exit-code mapping of run_main.
+#include <catch2/catch.hpp>
+
+#include "common/cli.h"
+#include "common/not_implemented.h"
+#include "common/timer.h"
+
+using Catch::Matchers::Contains;
+using Catch::Matchers::EndsWith;
+
+namespace {
+const std::string kLab01Scenes = std::string(CL_SOURCE_DIR) + "/labs/lab01_single_spring/scenes";
+
+int run_with(std::vector<std::string> arguments, const std::function<int()>& body) {
+  CLI::App app{"test", "probe"};
+  cl::CommonOptions options;
+  options.scene = "two-particles";
+  cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagDt);
+  arguments.insert(arguments.begin(), "probe");
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  return cl::run_main(app, static_cast<int>(argv.size()), argv.data(), body);
+}
+}  // namespace
+
+TEST_CASE("not_implemented names the function and the course-relative file", "[common][cli]") {
+  try {
+    cl::not_implemented("project_distance", CL_SOURCE_DIR "/labs/lab01_single_spring/single_spring.cpp");
+    FAIL("not_implemented returned");
+  } catch (const cl::NotImplemented& error) {
+    CHECK(error.function() == "project_distance");
+    CHECK(error.file() == "labs/lab01_single_spring/single_spring.cpp");
+    CHECK_THAT(std::string(error.what()), Contains("project_distance is not implemented yet"));
+  }
+}
+
+TEST_CASE("scene names resolve to shipped files, paths stay paths", "[common][cli]") {
+  CHECK_THAT(cl::resolve_scene_path("two-particles", kLab01Scenes), EndsWith("lab01_single_spring/scenes/two-particles.json"));
+  CHECK(cl::resolve_scene_path("some/dir/file.json", kLab01Scenes) == "some/dir/file.json");
+  try {
+    cl::resolve_scene_path("no-such-scene", kLab01Scenes);
+    FAIL("an unknown scene name was accepted");
+  } catch (const cl::InputError& error) {
+    CHECK_THAT(std::string(error.what()), Contains("no scene named 'no-such-scene'"));
+    CHECK_THAT(std::string(error.what()), Contains("two-particles"));
+  }
+}
+
+TEST_CASE("run_main maps each outcome to its exit code", "[common][cli]") {
+  CHECK(run_with({}, [] { return 0; }) == 0);
+  CHECK(run_with({"--dt", "0.01"}, [] { return 0; }) == 0);
+  CHECK(run_with({"--dt", "-1"}, [] { return 0; }) == 2);
+  CHECK(run_with({"--dt", "inf"}, [] { return 0; }) == 2);
+  CHECK(run_with({"--bogus"}, [] { return 0; }) == 2);
+  CHECK(run_with({}, []() -> int { throw cl::InputError("bad.json: springs[0].i: out of range"); }) == 2);
+  CHECK(run_with({}, []() -> int { cl::not_implemented("f", "labs/x.cpp"); }) == 3);
+  CHECK(run_with({}, []() -> int { throw std::runtime_error("boom"); }) == 1);
+}
+
+TEST_CASE("the timer counts forward", "[common][cli]") {
+  const cl::Timer timer;
+  const double first = timer.seconds();
+  CHECK(first >= 0.0);
+  CHECK(timer.seconds() >= first);
+}
