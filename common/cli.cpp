@@ -7,19 +7,19 @@
 
 namespace cl {
 
-namespace {
-const CLI::Validator kFinitePositive(
-    [](std::string& text) -> std::string {
-      try {
-        std::size_t used = 0;
-        const double value = std::stod(text, &used);
-        if (used == text.size() && std::isfinite(value) && value > 0.0) return {};
-      } catch (const std::exception&) {
-      }
-      return "must be a finite number > 0 (got " + text + ")";
-    },
-    "POSITIVE");
-}  // namespace
+CLI::Validator finite_number(bool allow_zero) {
+  return CLI::Validator(
+      [allow_zero](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double value = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(value) && (value > 0.0 || (allow_zero && value == 0.0))) return {};
+        } catch (const std::exception&) {
+        }
+        return std::string("must be a finite number ") + (allow_zero ? ">= 0" : "> 0") + " (got " + text + ")";
+      },
+      allow_zero ? "NUMBER >= 0" : "NUMBER > 0");
+}
 
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
   if (flags & kFlagScene) {
@@ -37,7 +37,7 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
         ->capture_default_str();
   }
   if (flags & kFlagDt) {
-    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(kFinitePositive);
+    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(finite_number(false));
   }
   if (flags & kFlagSteps) {
     app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")

@@ -34,6 +34,10 @@ struct CommonOptions {
   std::string summary;               // empty: no summary file
 };
 
+// A CLI11 check: a finite number > 0 (or >= 0 with allow_zero). Unlike CLI11's
+// own checks it rejects inf and nan and keeps the message to one short line.
+CLI::Validator finite_number(bool allow_zero);
+
 // Registers the flags in `flags` on `app`. Set the defaults in `options`
 // (scene, method, methods, iterations) before calling.
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);

@@ -1,0 +1,124 @@
+"""Lab 02 figures: Gauss-Seidel convergence for each spring order.
+
+Usage: /usr/bin/python3 plots/lab02_orders.py OUTDIR
+Reads OUTDIR/lab02_gauss_seidel/<scene>-<order>.json and <scene>-<order>/*.csv
+(written by labs/lab02_gauss_seidel/demo.txt) and writes, next to them:
+  lab02_orders.png            max strain error (log) against sweep, per order
+  lab02_error_vs_time.png     max strain error (log) against wall time
+  lab02_order_difference.png  how far apart the final states of two orders are
+Exit 4 when the runs are absent.
+"""
+import csv
+import json
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+LAB = "lab02_gauss_seidel"
+SCENES = [("chain", "perturbed chain (20 links)"),
+          ("cloth", "perturbed cloth 16x16, structural"),
+          ("cloth-shear", "perturbed cloth 16x16, + shear, bending")]
+ORDERS = [("forward", "tab:blue"), ("reverse", "tab:orange"), ("random", "tab:green")]
+FLOOR = 1e-17  # an error of exactly 0 is drawn here on the log axis
+
+
+def read_csv(path):
+    with open(path, newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    return {key: [float(row[key]) for row in rows] for key in rows[0]} if rows else {}
+
+
+def load_runs(lab_dir):
+    runs = {}
+    for prefix, _ in SCENES:
+        for order, _ in ORDERS:
+            name = f"{prefix}-{order}"
+            summary, table = lab_dir / f"{name}.json", lab_dir / name / "convergence.csv"
+            if summary.is_file() and table.is_file():
+                runs[name] = (json.loads(summary.read_text()), read_csv(table))
+    return runs
+
+
+def floor(values):
+    return [max(value, FLOOR) for value in values]
+
+
+def convergence_figure(runs, x_key, x_label, x_scale, path):
+    figure, axes = plt.subplots(1, len(SCENES), figsize=(5 * len(SCENES), 4), squeeze=False)
+    for axis, (prefix, title) in zip(axes[0], SCENES):
+        for order, color in ORDERS:
+            run = runs.get(f"{prefix}-{order}")
+            if not run:
+                continue
+            summary, table = run
+            x = [value * x_scale for value in table[x_key]]
+            reached = summary.get("sweeps_to_tolerance")
+            label = f"{order}: " + (f"1e-10 at sweep {reached}" if reached is not None else summary["outcome"])
+            axis.semilogy(x, floor(table["max_strain_error"]), color=color, label=label)
+            axis.axhline(summary["tolerance"], color="0.6", linestyle=":", linewidth=1)
+        axis.set_title(title)
+        axis.set_xlabel(x_label)
+        axis.set_ylabel("max strain error |l - L| / L (1)")
+        axis.grid(True, which="major", alpha=0.3)
+        axis.legend(fontsize=8)
+    figure.suptitle("Lab 02: Gauss-Seidel, one curve per spring order (dotted: tolerance)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def difference_figure(lab_dir, runs, path):
+    figure, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for axis, prefix in zip(axes, ["chain", "cloth"]):
+        name = f"{prefix}-forward"
+        positions = lab_dir / name / "positions.csv"
+        if name not in runs or not positions.is_file():
+            axis.set_visible(False)
+            continue
+        summary, _ = runs[name]
+        table = read_csv(positions)
+        if "x_compare" not in table:
+            axis.set_visible(False)
+            continue
+        distance = [((a - b) ** 2 + (c - d) ** 2 + (e - f) ** 2) ** 0.5
+                    for a, b, c, d, e, f in zip(table["x"], table["x_compare"], table["y"], table["y_compare"],
+                                                table["z"], table["z_compare"])]
+        axis.semilogy(table["particle"], floor(distance), "o-", markersize=3, color="tab:purple",
+                      label="|x_forward - x_reverse| per particle")
+        compare = summary["compare"]
+        axis.axhline(summary["max_strain_error"], color="tab:blue", linestyle="--",
+                     label=f"max strain error, forward: {summary['max_strain_error']:.1e}")
+        axis.axhline(compare["max_strain_error"], color="tab:orange", linestyle=":",
+                     label=f"max strain error, reverse: {compare['max_strain_error']:.1e}")
+        axis.set_title(f"{summary['scene']}: final states after {summary['iterations']} sweeps")
+        axis.set_xlabel("particle index")
+        axis.set_ylabel("distance (m) / strain error (1)")
+        axis.grid(True, alpha=0.3)
+        axis.legend(fontsize=8)
+    figure.suptitle("Both orders satisfy every spring to round-off, at different positions (0 is drawn at 1e-17)")
+    figure.tight_layout()
+    figure.savefig(path, dpi=120)
+    plt.close(figure)
+
+
+def main(argv):
+    if len(argv) != 2:
+        print("usage: plots/lab02_orders.py OUTDIR", file=sys.stderr)
+        return 2
+    lab_dir = Path(argv[1]) / LAB
+    runs = load_runs(lab_dir)
+    if not runs:
+        print(f"lab02_orders: no order runs in {lab_dir} (run ./course demo)", file=sys.stderr)
+        return 4
+    convergence_figure(runs, "sweep", "sweep", 1.0, lab_dir / "lab02_orders.png")
+    convergence_figure(runs, "total_seconds", "wall time of the sweeps (ms)", 1e3, lab_dir / "lab02_error_vs_time.png")
+    difference_figure(lab_dir, runs, lab_dir / "lab02_order_difference.png")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
