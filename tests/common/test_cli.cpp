@@ -1,4 +1,7 @@
 // The shared command line: scene lookup and the exit-code mapping of run_main.
+#include <filesystem>
+#include <map>
+
 #include <catch2/catch.hpp>
 
 #include "common/cli.h"
@@ -62,4 +65,32 @@ TEST_CASE("the timer counts forward", "[common][cli]") {
   const double first = timer.seconds();
   CHECK(first >= 0.0);
   CHECK(timer.seconds() >= first);
+}
+
+TEST_CASE("scene names are unique across labs, so --scene NAME is never ambiguous", "[common][cli]") {
+  namespace fs = std::filesystem;
+  std::map<std::string, std::string> owner;
+  for (const auto& lab : fs::directory_iterator(fs::path(CL_SOURCE_DIR) / "labs")) {
+    for (const std::string& name : cl::list_scene_names((lab.path() / "scenes").string())) {
+      CAPTURE(name, lab.path().filename().string());
+      const auto [where, inserted] = owner.emplace(name, lab.path().filename().string());
+      CAPTURE(where->second);
+      CHECK(inserted);
+    }
+  }
+  CHECK(owner.count("two-particles") == 1);
+}
+
+TEST_CASE("every shipped scene loads", "[common][cli]") {
+  namespace fs = std::filesystem;
+  int count = 0;
+  for (const auto& lab : fs::directory_iterator(fs::path(CL_SOURCE_DIR) / "labs")) {
+    const fs::path dir = lab.path() / "scenes";
+    for (const std::string& name : cl::list_scene_names(dir.string())) {
+      CAPTURE((dir / (name + ".json")).string());
+      CHECK_NOTHROW(cl::load_scene((dir / (name + ".json")).string()));
+      ++count;
+    }
+  }
+  CHECK(count > 0);
 }
