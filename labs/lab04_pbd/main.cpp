@@ -1,2 +1,384 @@
-// placeholder driver: replaced by the real one
-int main() { return 0; }
+// lab04_pbd: position based dynamics on a scene, frame by frame: per-frame
+// strain and energy (per_frame.csv), OBJ meshes every --frames N frames, and
+// the run summary. Two experiments, one invocation each:
+//   --sweep-iterations 1,2,...,128          steady strain against K  -> strain_vs_iterations.csv
+//   --sweep-substeps 1,2,...,64 --cost C    substeps × K = C fixed   -> substeps.csv
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/csv.h"
+#include "common/metrics.h"
+#include "common/obj.h"
+#include "common/output.h"
+#include "common/summary.h"
+#include "pbd.h"
+#include "simulation.h"
+
+namespace {
+
+constexpr const char* kLab = CL_LAB_NAME;
+
+struct LabOptions {
+  int substeps = 1;
+  double omega = 1.0;
+  int frames_every = 0;            // 0: no OBJ frames
+  double window_seconds = 1.0;     // the averaging window
+  double settle_tolerance = 0.02;  // sweeps: stop once three windows agree to this
+  double energy_seconds = 2.0;     // sweeps: the energy is compared at this time
+  std::vector<int> sweep_iterations;
+  std::vector<int> sweep_substeps;
+  int cost = 0;                    // substeps × iterations for --sweep-substeps
+  std::vector<std::string> sweep_scenes;
+};
+
+// A finite number in [low, high]; CLI::Range alone lets "nan" through.
+CLI::Validator finite_in(double low, double high) {
+  return CLI::Validator(
+      [low, high](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double value = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(value) && value >= low && value <= high) return {};
+        } catch (const std::exception&) {
+        }
+        std::ostringstream message;
+        message << "must be a finite number in [" << low << ", " << high << "] (got " << text << ")";
+        return message.str();
+      },
+      "NUMBER");
+}
+
+cl::lab04::PbdSettings frame_settings(const cl::Scene& scene, const cl::CommonOptions& options,
+                                      const LabOptions& lab, int iterations) {
+  cl::lab04::PbdSettings settings;
+  settings.dt = scene.dt;
+  settings.gravity = scene.gravity;
+  settings.iterations = iterations;
+  settings.projection =
+      options.method == "jacobi" ? cl::lab04::Projection::kJacobi : cl::lab04::Projection::kGaussSeidel;
+  settings.omega = lab.omega;
+  return settings;
+}
+
+// Seconds of the scene's frames, at least one frame.
+int frames_in(double seconds, const cl::Scene& scene) {
+  return std::max(1, static_cast<int>(std::lround(seconds / scene.dt)));
+}
+
+std::string describe(const cl::Scene& scene) {
+  std::ostringstream text;
+  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
+  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
+  text << ")";
+  return text.str();
+}
+
+std::string frame_file(int frame) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.obj", frame);
+  return name;
+}
+
+// ------------------------------------------------------------------ one run
+
+int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
+  cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  const std::string frames_dir = cl::join_path(options.out, "frames");
+  if (lab.frames_every > 0) cl::ensure_directory(frames_dir);
+
+  const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
+  const cl::lab04::PbdSettings settings = frame_settings(scene, options, lab, options.iterations);
+  cl::lab04::RunPlan plan;
+  plan.frames = scene.steps;
+  plan.window_frames = frames_in(lab.window_seconds, scene);
+  const double window_seconds = plan.window_frames * scene.dt;
+
+  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "kinetic", "potential", "total_energy",
+                      "seconds", "status"});
+  int frames_written = 0;
+  const cl::lab04::FrameCallback on_frame = [&](const cl::lab04::FrameRecord& record, const cl::Particles& state) {
+    const std::string& problem = record.problem;
+    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
+                   record.kinetic, record.potential, record.kinetic + record.potential, record.seconds,
+                   problem.empty() ? std::string("ok") : "diverged: " + problem});
+    const bool last = record.frame == scene.steps;
+    if (lab.frames_every > 0 && problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
+      cl::write_file_atomic(cl::join_path(frames_dir, frame_file(record.frame)),
+                            cl::obj_text(state.x, scene.triangles, scene.springs,
+                                         std::string(kLab) + " scene " + scene.name + " frame " +
+                                             std::to_string(record.frame) + " time " + cl::format_double(record.time)));
+      ++frames_written;
+    }
+  };
+
+  cl::Particles& particles = scene.particles;
+  const cl::lab04::RunResult result =
+      cl::lab04::run_frames(particles, constraints, settings, lab.substeps, plan, on_frame);
+  const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+  const double kinetic = cl::kinetic_energy(particles);
+  const double potential = cl::potential_energy(particles, scene.gravity);
+  const bool diverged = !result.problem.empty();
+
+  std::printf("%s: scene %s, %s, K = %d, %d substep(s) of %.4g s per %.4g s frame, %d frames\n", kLab,
+              describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps,
+              scene.dt / lab.substeps, scene.dt, scene.steps);
+  if (diverged) {
+    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
+                result.problem_frame * scene.dt, result.problem.c_str());
+  } else {
+    std::printf("  final:   max strain %.3e  rms %.3e\n", strain.max, strain.rms);
+    if (result.windows_done > 0) {
+      std::printf("  last %.3g s: mean max strain %.3e  mean rms %.3e", window_seconds, result.window_max_strain,
+                  result.window_rms_strain);
+      if (result.previous_window_max_strain >= 0.0) {
+        std::printf("  (the %.3g s before: %.3e)", window_seconds, result.previous_window_max_strain);
+      }
+      std::printf("\n");
+    }
+    std::printf("  energy:  kinetic %.4e J  potential %.4e J  total %.6e J (start %.6e J)\n", kinetic, potential,
+                kinetic + potential, result.energy_start);
+  }
+  const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
+                             static_cast<double>(scene.springs.size());
+  std::printf("  time %.3e s: %.3e s per frame", result.seconds,
+              result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
+  if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
+  std::printf("\n");
+  if (frames_written > 0) std::printf("  %d OBJ frames in %s\n", frames_written, frames_dir.c_str());
+
+  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
+  if (!options.summary.empty()) {
+    cl::RunSummary summary;
+    summary.lab = kLab;
+    summary.method = options.method;
+    summary.scene = scene.name;
+    summary.dt = scene.dt;
+    summary.steps = scene.steps;
+    summary.iterations = options.iterations;
+    summary.positions = particles.x;
+    summary.velocities = particles.v;
+    summary.max_strain_error = strain.max;
+    summary.seconds = result.seconds;
+    summary.extra["substeps"] = lab.substeps;
+    if (settings.projection == cl::lab04::Projection::kJacobi) summary.extra["omega"] = lab.omega;
+    summary.extra["rms_strain_error"] = strain.rms;
+    if (!diverged && result.windows_done > 0) {
+      summary.extra["window_seconds"] = window_seconds;
+      summary.extra["window_max_strain_error"] = result.window_max_strain;
+      summary.extra["window_rms_strain_error"] = result.window_rms_strain;
+    }
+    summary.extra["kinetic_energy"] = kinetic;
+    summary.extra["potential_energy"] = potential;
+    summary.extra["total_energy"] = kinetic + potential;
+    summary.extra["total_energy_start"] = result.energy_start;
+    summary.extra["diverged"] = diverged;
+    if (diverged) {
+      summary.extra["diverged_at_frame"] = result.problem_frame;
+      summary.extra["problem"] = result.problem;
+    }
+    cl::write_summary(options.summary, summary);
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------ sweeps
+
+struct SweepRun {
+  std::size_t scene = 0;
+  int substeps = 1;
+  int iterations = 0;
+  cl::lab04::RunResult result;
+};
+
+std::string status_of(const cl::lab04::RunResult& result) {
+  if (!result.problem.empty()) {
+    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
+  }
+  return result.settled ? "settled" : "not settled";
+}
+
+// Runs every scene at every (substeps, iterations) point until it settles (or
+// for --steps frames at most); one CSV row per run. The runs are independent,
+// so they are shared among the OpenMP threads, costliest first; each run's
+// wall time is its own.
+int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
+              const std::vector<std::pair<int, int>>& points, const std::string& csv_name) {
+  std::vector<cl::Scene> scenes;
+  for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene}
+                                                          : lab.sweep_scenes) {
+    cl::CommonOptions one = options;
+    one.scene = name;
+    scenes.push_back(cl::load_scene_for(one, CL_LAB_SCENE_DIR));
+  }
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  std::vector<cl::lab04::ConstraintSet> constraints;
+  for (const cl::Scene& scene : scenes) {
+    constraints.push_back(cl::lab04::make_constraint_set(scene.particles.size(), scene.springs));
+  }
+
+  std::vector<SweepRun> runs;
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    for (const auto& [substeps, iterations] : points) runs.push_back({s, substeps, iterations, {}});
+  }
+  std::vector<std::size_t> by_cost(runs.size());
+  for (std::size_t r = 0; r < runs.size(); ++r) by_cost[r] = r;
+  auto cost = [&](const SweepRun& run) {
+    return static_cast<double>(scenes[run.scene].springs.size() + 1) * run.substeps * std::max(run.iterations, 1);
+  };
+  std::stable_sort(by_cost.begin(), by_cost.end(),
+                   [&](std::size_t a, std::size_t b) { return cost(runs[a]) > cost(runs[b]); });
+
+  std::exception_ptr failure;
+  const auto count = static_cast<long>(runs.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long k = 0; k < count; ++k) {
+    SweepRun& run = runs[by_cost[static_cast<std::size_t>(k)]];
+    const cl::Scene& scene = scenes[run.scene];
+    try {
+      cl::Particles particles = scene.particles;
+      cl::lab04::RunPlan plan;
+      plan.frames = scene.steps;
+      plan.window_frames = frames_in(lab.window_seconds, scene);
+      plan.settle_tolerance = lab.settle_tolerance;
+      plan.energy_frame = frames_in(lab.energy_seconds, scene);
+      run.result = cl::lab04::run_frames(particles, constraints[run.scene],
+                                         frame_settings(scene, options, lab, run.iterations), run.substeps, plan);
+    } catch (...) {
+#pragma omp critical(lab04_sweep_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+
+  cl::CsvTable table({"scene", "nx", "ny", "particles", "springs", "method", "dt", "substeps", "iterations",
+                      "frames_run", "time_run", "window_seconds", "steady_max_strain", "steady_rms_strain",
+                      "window_spread", "energy_start", "energy_seconds", "energy_at_seconds", "energy_end",
+                      "max_energy_rise", "seconds", "status"});
+  std::printf("%s: %s; each run until the mean max strain of three %.3g s windows agrees to %.3g (at most %s "
+              "frames)\n",
+              kLab, options.method.c_str(), lab.window_seconds, lab.settle_tolerance,
+              options.steps >= 0 ? std::to_string(options.steps).c_str() : "the scene's");
+  std::printf("%-12s %8s %10s %12s %12s %8s %8s %13s %9s  %s\n", "scene", "substeps", "iterations", "steady_max",
+              "steady_rms", "spread", "t_run/s", "E(te)-E(0)/J", "seconds", "status");
+  for (const SweepRun& run : runs) {
+    const cl::Scene& scene = scenes[run.scene];
+    const cl::lab04::RunResult& result = run.result;
+    const bool ok = result.problem.empty();
+    const bool measured = ok && result.windows_done > 0;
+    const bool energy_known = ok && result.frames_done >= frames_in(lab.energy_seconds, scene);
+    auto value = [](bool known, double number) -> cl::CsvCell {
+      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
+    };
+    const double window_seconds = frames_in(lab.window_seconds, scene) * scene.dt;
+    const double energy_seconds = frames_in(lab.energy_seconds, scene) * scene.dt;
+    table.add_row({scene.name, static_cast<long long>(scene.grid_nx), static_cast<long long>(scene.grid_ny),
+                   static_cast<long long>(scene.particles.size()), static_cast<long long>(scene.springs.size()),
+                   options.method, scene.dt, static_cast<long long>(run.substeps),
+                   static_cast<long long>(run.iterations), static_cast<long long>(result.frames_done),
+                   result.frames_done * scene.dt, window_seconds, value(measured, result.window_max_strain),
+                   value(measured, result.window_rms_strain),
+                   value(measured && result.window_spread >= 0.0, result.window_spread), result.energy_start,
+                   energy_seconds, value(energy_known, result.energy_at_mark), value(ok, result.energy_end),
+                   result.max_energy_rise, result.seconds, status_of(result)});
+    if (measured) {
+      std::printf("%-12s %8d %10d %12.4e %12.4e %8.1e %8.2f %13.4e %9.3f  %s\n", scene.name.c_str(), run.substeps,
+                  run.iterations, result.window_max_strain, result.window_rms_strain, result.window_spread,
+                  result.frames_done * scene.dt, energy_known ? result.energy_at_mark - result.energy_start : 0.0,
+                  result.seconds, status_of(result).c_str());
+    } else {
+      std::printf("%-12s %8d %10d  %s\n", scene.name.c_str(), run.substeps, run.iterations,
+                  ok ? "too short for one window" : status_of(result).c_str());
+    }
+  }
+  if (!options.out.empty()) table.write(cl::join_path(options.out, csv_name));
+  return 0;
+}
+
+int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (lab.frames_every > 0 && options.out.empty()) throw cl::InputError("--frames: needs --out DIR for the OBJ files");
+  const bool sweep = !lab.sweep_iterations.empty() || !lab.sweep_substeps.empty();
+  if (!sweep) {
+    if (!lab.sweep_scenes.empty()) {
+      throw cl::InputError("--sweep-scenes: only with --sweep-iterations or --sweep-substeps");
+    }
+    return run_one(options, lab);
+  }
+  if (lab.frames_every > 0) throw cl::InputError("--frames: not with a sweep (run one configuration instead)");
+  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
+  std::vector<std::pair<int, int>> points;  // (substeps, iterations)
+  if (!lab.sweep_iterations.empty()) {
+    for (const int k : lab.sweep_iterations) points.emplace_back(lab.substeps, k);
+    return run_sweep(options, lab, points, "strain_vs_iterations.csv");
+  }
+  if (lab.cost < 1) throw cl::InputError("--sweep-substeps: needs --cost C (substeps × iterations)");
+  for (const int n : lab.sweep_substeps) {
+    if (lab.cost % n != 0) {
+      throw cl::InputError("--sweep-substeps: " + std::to_string(n) + " does not divide --cost " +
+                           std::to_string(lab.cost));
+    }
+    points.emplace_back(n, lab.cost / n);
+  }
+  return run_sweep(options, lab, points, "substeps.csv");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
+               "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
+               kLab};
+  cl::CommonOptions options;
+  options.scene = "curtain-16";
+  options.method = "gauss-seidel";
+  options.methods = {"gauss-seidel", "jacobi"};
+  options.iterations = 10;
+  cl::add_common_options(app, options,
+                         cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
+                             cl::kFlagOut | cl::kFlagSummary);
+  LabOptions lab;
+  app.add_option("--substeps", lab.substeps, "PBD steps of dt/n per frame")
+      ->check(CLI::Range(1, 1'000'000))
+      ->capture_default_str();
+  app.add_option("--omega", lab.omega, "Jacobi relaxation factor ω (lab 03)")
+      ->check(finite_in(0.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--frames", lab.frames_every, "write an OBJ of the mesh every N frames into OUT/frames/")
+      ->check(CLI::Range(1, 100'000'000));
+  app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady strain")
+      ->check(finite_in(1e-9, 1e9))
+      ->capture_default_str();
+  CLI::Option* iterations_sweep =
+      app.add_option("--sweep-iterations", lab.sweep_iterations,
+                     "run the scene(s) once per K in this list (e.g. 1,2,4,8) and write strain_vs_iterations.csv; "
+                     "--steps is then the most frames a run may take to settle")
+          ->delimiter(',')
+          ->check(CLI::Range(0, 1'000'000));
+  CLI::Option* substeps_sweep =
+      app.add_option("--sweep-substeps", lab.sweep_substeps,
+                     "run the scene(s) once per substep count n in this list with K = C/n (--cost C) and write "
+                     "substeps.csv")
+          ->delimiter(',')
+          ->check(CLI::Range(1, 1'000'000));
+  iterations_sweep->excludes(substeps_sweep);
+  app.add_option("--cost", lab.cost, "substeps × iterations, fixed across --sweep-substeps")
+      ->check(CLI::Range(1, 100'000'000));
+  app.add_option("--sweep-scenes", lab.sweep_scenes,
+                 "scenes for a sweep (default: --scene), e.g. curtain-8,curtain-16")
+      ->delimiter(',');
+  app.add_option("--settle-tolerance", lab.settle_tolerance,
+                 "sweeps: a run has settled when the mean max strain of its last three windows agree to this "
+                 "relative spread (0: run all --steps frames)")
+      ->check(finite_in(0.0, 1e9))
+      ->capture_default_str();
+  app.add_option("--energy-seconds", lab.energy_seconds, "sweeps: compare the total energy at this time")
+      ->check(finite_in(0.0, 1e9))
+      ->capture_default_str();
+  return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
+}

@@ -25,7 +25,8 @@ struct PbdSettings {
   double omega = 1.0;                              // Jacobi relaxation (lab 03)
 };
 
-// The springs and what the two sweeps need about them, built once per scene.
+// The springs and what the two sweeps need about them, built once per scene
+// (given code: make_constraint_set, in constraint_set.cpp).
 struct ConstraintSet {
   std::vector<Spring> springs;
   std::vector<int> order;      // Gauss-Seidel order (file order: 0 … m−1)
@@ -44,8 +45,13 @@ ConstraintSet make_constraint_set(Eigen::Index particle_count, std::vector<Sprin
 //     v ← (p − x) / Δt,   x ← p.
 // With no springs this is symplectic Euler: x_n = x_0 + nΔt v_0 + Δt² g n(n+1)/2.
 //
-// Shapes: particles.x and .v are 3 × n, updated in place. Throws
-// std::invalid_argument for dt that is not finite and > 0, or iterations < 0.
+// Every spring is a hard distance constraint here (its stiffness is not used):
+// how stiff the result is depends on K, Δt and the mesh (README.md).
+//
+// Shapes: particles.x and .v are 3 × n, updated in place; inv_mass has n
+// entries. Throws std::invalid_argument, before changing anything, for dt that
+// is not finite and > 0, iterations < 0, or v / inv_mass not sized for n
+// particles; the sweeps throw for invalid springs or ω as labs 02 and 03 say.
 void pbd_step(Particles& particles, const ConstraintSet& constraints, const PbdSettings& settings);
 
 }  // namespace cl::lab04

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/csv.h"
+#include "common/obj.h"
 #include "common/output.h"
 #include "common/summary.h"
 
@@ -63,4 +64,14 @@ TEST_CASE("the run summary has the contract's keys and exact positions", "[commo
   CHECK_FALSE(parsed.contains("velocities"));
   CHECK_FALSE(parsed.contains("dt"));
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("OBJ text: vertices, then faces or, without triangles, lines", "[common][output]") {
+  Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, 3);
+  x(0, 1) = 1.0;
+  x(1, 2) = 0.1;
+  const std::string mesh = cl::obj_text(x, {cl::Triangle{0, 1, 2, 0.05}}, {cl::Spring{0, 1, 1.0}}, "mesh");
+  CHECK(mesh == "# mesh\nv 0 0 0\nv 1 0 0\nv 0 0.10000000000000001 0\nf 1 2 3\n");
+  const std::string rope = cl::obj_text(x, {}, {cl::Spring{0, 1, 1.0}, cl::Spring{1, 2, 1.0}}, "rope");
+  CHECK(rope.substr(rope.find("l ")) == "l 1 2\nl 2 3\n");
 }
