@@ -158,14 +158,21 @@ def cell(value, fmt="{:.3g}"):
     return fmt.format(value) if isinstance(value, (int, float)) else str(value)
 
 
+def outcome(summary):
+    """What a run reported about itself: its "outcome", or "diverged", or nothing."""
+    if "outcome" in summary:
+        return str(summary["outcome"])
+    return "diverged" if summary.get("diverged") else ""
+
+
 def print_summary_table(out):
     rows = [[cell(s["lab"]), cell(s.get("scene")), cell(s.get("method")),
              cell(s.get("iterations"), "{}"), cell(s.get("max_strain_error")),
-             cell(s["seconds"])]
+             cell(s["seconds"]), outcome(s)]
             for s in summaries(out)]
     if not rows:
         return
-    header = ["lab", "scene", "method", "iterations", "max_strain_error", "seconds"]
+    header = ["lab", "scene", "method", "iterations", "max_strain_error", "seconds", "outcome"]
     widths = [max(len(row[i]) for row in [header, *rows]) for i in range(len(header))]
     print()
     for row in [header, *rows]:
@@ -366,6 +373,8 @@ def cmd_test(argv):
     else:
         print("no solutions/ here: grading your code (a score, not a check)")
         report_student_score(labs)
+        print("the demo and the plots run your code here: try them with ./course demo")
+        return checks.finish()
     out = BUILD / "test-demo"
     check_demo(checks, out)
     for script, (status, error) in run_plots(out, echo=False).items():
