@@ -134,7 +134,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int main(int argc, char** argv) {
   CLI::App app{"Lab 02: Gauss-Seidel sweeps over a scene's springs; strain error and position change per sweep.",
-               kLab};
+               CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "perturbed-chain";
   options.iterations = 100;

@@ -130,7 +130,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 int main(int argc, char** argv) {
   CLI::App app{"Lab 03: Jacobi sweeps (or Gauss-Seidel, for comparison) over a scene's springs; strain error, "
                "position change and wall time per sweep.",
-               kLab};
+               CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "chain-20";
   options.iterations = 100;

@@ -333,7 +333,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 int main(int argc, char** argv) {
   CLI::App app{"Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
                "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
-               kLab};
+               CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "curtain-16";
   options.method = "gauss-seidel";
