@@ -2,23 +2,45 @@
 
 #include <cmath>
 #include <iostream>
+#include <sstream>
 
 #include "common/not_implemented.h"
 
 namespace cl {
 
+namespace {
+// Reads a whole argument as a finite double; false for anything else.
+bool parse_finite(const std::string& text, double& value) {
+  try {
+    std::size_t used = 0;
+    value = std::stod(text, &used);
+    return used == text.size() && std::isfinite(value);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+}  // namespace
+
 CLI::Validator finite_number(bool allow_zero) {
   return CLI::Validator(
       [allow_zero](std::string& text) -> std::string {
-        try {
-          std::size_t used = 0;
-          const double value = std::stod(text, &used);
-          if (used == text.size() && std::isfinite(value) && (value > 0.0 || (allow_zero && value == 0.0))) return {};
-        } catch (const std::exception&) {
-        }
+        double value = 0.0;
+        if (parse_finite(text, value) && (value > 0.0 || (allow_zero && value == 0.0))) return {};
         return std::string("must be a finite number ") + (allow_zero ? ">= 0" : "> 0") + " (got " + text + ")";
       },
       allow_zero ? "NUMBER >= 0" : "NUMBER > 0");
+}
+
+CLI::Validator finite_in(double low, double high) {
+  return CLI::Validator(
+      [low, high](std::string& text) -> std::string {
+        double value = 0.0;
+        if (parse_finite(text, value) && value >= low && value <= high) return {};
+        std::ostringstream message;
+        message << "must be a finite number in [" << low << ", " << high << "] (got " << text << ")";
+        return message.str();
+      },
+      "NUMBER");
 }
 
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {

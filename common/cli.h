@@ -38,6 +38,9 @@ struct CommonOptions {
 // own checks it rejects inf and nan and keeps the message to one short line.
 CLI::Validator finite_number(bool allow_zero);
 
+// A CLI11 check: a finite number in [low, high] (CLI::Range lets "nan" through).
+CLI::Validator finite_in(double low, double high);
+
 // Registers the flags in `flags` on `app`. Set the defaults in `options`
 // (scene, method, methods, iterations) before calling.
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);

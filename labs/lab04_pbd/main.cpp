@@ -37,23 +37,6 @@ struct LabOptions {
   std::vector<std::string> sweep_scenes;
 };
 
-// A finite number in [low, high]; CLI::Range alone lets "nan" through.
-CLI::Validator finite_in(double low, double high) {
-  return CLI::Validator(
-      [low, high](std::string& text) -> std::string {
-        try {
-          std::size_t used = 0;
-          const double value = std::stod(text, &used);
-          if (used == text.size() && std::isfinite(value) && value >= low && value <= high) return {};
-        } catch (const std::exception&) {
-        }
-        std::ostringstream message;
-        message << "must be a finite number in [" << low << ", " << high << "] (got " << text << ")";
-        return message.str();
-      },
-      "NUMBER");
-}
-
 cl::lab04::PbdSettings frame_settings(const cl::Scene& scene, const cl::CommonOptions& options,
                                       const LabOptions& lab, int iterations) {
   cl::lab04::PbdSettings settings;
@@ -347,12 +330,12 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1'000'000))
       ->capture_default_str();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor ω (lab 03)")
-      ->check(finite_in(0.0, 100.0))
+      ->check(cl::finite_in(0.0, 100.0))
       ->capture_default_str();
   app.add_option("--frames", lab.frames_every, "write an OBJ of the mesh every N frames into OUT/frames/")
       ->check(CLI::Range(1, 100'000'000));
   app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady strain")
-      ->check(finite_in(1e-9, 1e9))
+      ->check(cl::finite_in(1e-9, 1e9))
       ->capture_default_str();
   CLI::Option* iterations_sweep =
       app.add_option("--sweep-iterations", lab.sweep_iterations,
@@ -375,10 +358,10 @@ int main(int argc, char** argv) {
   app.add_option("--settle-tolerance", lab.settle_tolerance,
                  "sweeps: a run has settled when the mean max strain of its last three windows agree to this "
                  "relative spread (0: run all --steps frames)")
-      ->check(finite_in(0.0, 1e9))
+      ->check(cl::finite_in(0.0, 1e9))
       ->capture_default_str();
   app.add_option("--energy-seconds", lab.energy_seconds, "sweeps: compare the total energy at this time")
-      ->check(finite_in(0.0, 1e9))
+      ->check(cl::finite_in(0.0, 1e9))
       ->capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -94,3 +94,15 @@ TEST_CASE("every shipped scene loads", "[common][cli]") {
   }
   CHECK(count > 0);
 }
+
+TEST_CASE("finite_in accepts [low, high] and rejects nan, inf and text", "[common][cli]") {
+  const CLI::Validator check = cl::finite_in(0.0, 2.0);
+  for (std::string good : {"0", "2", "1.5"}) {
+    CAPTURE(good);
+    CHECK(check(good).empty());
+  }
+  for (std::string bad : {"-0.1", "2.5", "nan", "inf", "1x", ""}) {
+    CAPTURE(bad);
+    CHECK_FALSE(check(bad).empty());
+  }
+}
