@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "common/health.h"
 #include "common/metrics.h"
 #include "pbd.h"
 
@@ -16,21 +17,7 @@ namespace cl::lab04 {
 void advance_frame(Particles& particles, const ConstraintSet& constraints, const PbdSettings& frame,
                    int substeps);
 
-// Strain at or above this is reported as an unstable run (a spring 1000 times
-// its rest length is not a cloth any more).
-constexpr double kUnstableStrain = 1e3;
-
-// Empty when the state is healthy; otherwise one line saying what went wrong:
-// non-finite positions or velocities, non-finite strain, or strain >= kUnstableStrain.
-std::string health_problem(const Particles& particles, const StrainStats& strain);
-
-// The energy a scene could plausibly gain from its own start: Σ over movable
-// particles of m (|g| D + ½ ‖v0‖²), D the diagonal of the initial bounding box
-// (falling the scene's own size); when that is 0 (no gravity, at rest),
-// Σ m ½ (D / dt)². Gravity and hard constraints can only lose energy, so a
-// total energy more than this above its start means the solver is pumping
-// energy in: run_frames reports it as unstable.
-double energy_scale(const Particles& particles, const Eigen::Vector3d& gravity, double dt);
+// health_problem, energy_scale and kUnstableStrain live in common/health.h.
 
 // What one frame looked like after it was computed (frame 0: the initial state).
 struct FrameRecord {
