@@ -1,0 +1,297 @@
+// lab08_xpbd: PBD or XPBD on a scene, frame by frame: per-frame strain,
+// stretch and energy (per_frame.csv) and the run summary with each spring's
+// multiplier. The experiment, one invocation per method:
+//   --sweep-iterations 1,2,...,1024   steady stretch against K -> stretch_vs_iterations_<method>.csv
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <exception>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/csv.h"
+#include "common/metrics.h"
+#include "common/output.h"
+#include "common/summary.h"
+#include "pbd.h"
+#include "simulation.h"
+#include "xpbd.h"
+
+namespace {
+
+constexpr const char* kLab = CL_LAB_NAME;
+
+struct LabOptions {
+  int substeps = 1;
+  double window_seconds = 1.0;      // the averaging window
+  double settle_tolerance = 1e-3;   // sweeps: stop once three windows agree to this
+  std::vector<int> sweep_iterations;
+};
+
+cl::lab08::FrameSettings frame_settings(const cl::Scene& scene, const cl::CommonOptions& options,
+                                        const LabOptions& lab, int iterations) {
+  cl::lab08::FrameSettings settings;
+  settings.method = options.method == "pbd" ? cl::lab08::Method::kPbd : cl::lab08::Method::kXpbd;
+  settings.dt = scene.dt;
+  settings.gravity = scene.gravity;
+  settings.iterations = iterations;
+  settings.substeps = lab.substeps;
+  return settings;
+}
+
+// Seconds of the scene's frames, at least one frame.
+int frames_in(double seconds, const cl::Scene& scene) {
+  return std::max(1, static_cast<int>(std::lround(seconds / scene.dt)));
+}
+
+std::string describe(const cl::Scene& scene) {
+  std::ostringstream text;
+  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
+  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
+  text << ")";
+  return text.str();
+}
+
+// The multipliers in newtons: λ / Δt² with Δt the substep (λ is force × Δt²).
+std::vector<double> multipliers_in_newtons(const Eigen::VectorXd& lambda, double substep) {
+  std::vector<double> forces(static_cast<std::size_t>(lambda.size()));
+  for (Eigen::Index s = 0; s < lambda.size(); ++s) forces[static_cast<std::size_t>(s)] = lambda[s] / (substep * substep);
+  return forces;
+}
+
+// ------------------------------------------------------------------ one run
+
+int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
+  cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+
+  const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
+  const cl::lab08::FrameSettings settings = frame_settings(scene, options, lab, options.iterations);
+  const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
+  cl::lab08::RunPlan plan;
+  plan.frames = scene.steps;
+  plan.window_frames = frames_in(lab.window_seconds, scene);
+  const double window_seconds = plan.window_frames * scene.dt;
+
+  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "total_stretch", "kinetic", "potential",
+                      "elastic", "total_energy", "seconds", "status"});
+  const cl::lab08::FrameCallback on_frame = [&](const cl::lab08::FrameRecord& record, const cl::Particles&) {
+    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
+                   record.total_stretch, record.kinetic, record.potential, record.elastic,
+                   record.kinetic + record.potential + record.elastic, record.seconds,
+                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
+  };
+
+  cl::Particles& particles = scene.particles;
+  const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, on_frame);
+  const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+  const double stretch = cl::lab08::total_stretch(particles.x, scene.springs);
+  const double kinetic = cl::kinetic_energy(particles);
+  const double potential = cl::potential_energy(particles, scene.gravity);
+  // PBD's springs are hard constraints: they store nothing (as in run_frames).
+  const double elastic =
+      settings.method == cl::lab08::Method::kXpbd ? cl::lab08::elastic_energy(particles.x, scene.springs) : 0.0;
+  const bool diverged = !result.problem.empty();
+  const double substep = scene.dt / lab.substeps;
+  const std::vector<double> forces = multipliers_in_newtons(result.lambda, substep);
+
+  std::printf("%s: scene %s, %s, K = %d, %d substep(s) of %.4g s per %.4g s frame, %d frames\n", kLab,
+              describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps, substep, scene.dt,
+              scene.steps);
+  if (diverged) {
+    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
+                result.problem_frame * scene.dt, result.problem.c_str());
+  } else {
+    std::printf("  final:   max strain %.3e  rms %.3e  total stretch %.6e m", strain.max, strain.rms, stretch);
+    if (hanging) std::printf("  (hanging at rest from its pin, springs at their k: %.6e m)", *hanging);
+    std::printf("\n");
+    if (result.windows_done > 0) {
+      std::printf("  last %.3g s: mean total stretch %.6e m  mean max strain %.3e\n", window_seconds,
+                  result.window_total_stretch, result.window_max_strain);
+    }
+    if (!forces.empty()) {
+      const auto [low, high] = std::minmax_element(forces.begin(), forces.end());
+      std::printf("  multipliers λ/Δt² (last substep): %.6g N … %.6g N (spring 0: %.6g N; < 0 is tension)\n",
+                  *low, *high, forces.front());
+    }
+    std::printf("  energy:  kinetic %.4e J  potential %.4e J  elastic %.4e J  total %.6e J (start %.6e J)\n",
+                kinetic, potential, elastic, kinetic + potential + elastic, result.energy_start);
+  }
+  const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
+                             static_cast<double>(scene.springs.size());
+  std::printf("  time %.3e s: %.3e s per frame", result.seconds,
+              result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
+  if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
+  std::printf("\n");
+
+  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
+  if (!options.summary.empty()) {
+    cl::RunSummary summary;
+    summary.lab = kLab;
+    summary.method = options.method;
+    summary.scene = scene.name;
+    summary.dt = scene.dt;
+    summary.steps = scene.steps;
+    summary.iterations = options.iterations;
+    summary.positions = particles.x;
+    summary.velocities = particles.v;
+    summary.max_strain_error = strain.max;
+    summary.seconds = result.seconds;
+    summary.extra["substeps"] = lab.substeps;
+    // λ/Δt² of the last substep, N, file order (null for pbd: lab 04's step keeps none).
+    if (settings.method == cl::lab08::Method::kXpbd && !diverged) {
+      summary.extra["multipliers"] = forces;
+    } else {
+      summary.extra["multipliers"] = nullptr;
+    }
+    summary.extra["multipliers_unit"] = "N";
+    summary.extra["rms_strain_error"] = strain.rms;
+    summary.extra["total_stretch"] = stretch;
+    if (hanging) summary.extra["hanging_chain_stretch"] = *hanging;
+    if (!diverged && result.windows_done > 0) {
+      summary.extra["window_seconds"] = window_seconds;
+      summary.extra["window_total_stretch"] = result.window_total_stretch;
+      summary.extra["window_max_strain_error"] = result.window_max_strain;
+    }
+    summary.extra["kinetic_energy"] = kinetic;
+    summary.extra["potential_energy"] = potential;
+    summary.extra["elastic_energy"] = elastic;
+    summary.extra["total_energy"] = kinetic + potential + elastic;
+    summary.extra["total_energy_start"] = result.energy_start;
+    summary.extra["diverged"] = diverged;
+    if (diverged) {
+      summary.extra["diverged_at_frame"] = result.problem_frame;
+      summary.extra["problem"] = result.problem;
+    }
+    cl::write_summary(options.summary, summary);
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------ the sweep
+
+std::string status_of(const cl::lab08::RunResult& result) {
+  if (!result.problem.empty()) {
+    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
+  }
+  return result.settled ? "settled" : "not settled";
+}
+
+// Runs the scene once per K until its total stretch is steady (or for --steps
+// frames at most); one CSV row per K. The runs are independent and shared
+// among the OpenMP threads, costliest first; each row's seconds is its own.
+int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
+  const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
+  const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
+
+  std::vector<int> ks = lab.sweep_iterations;
+  std::vector<cl::lab08::RunResult> results(ks.size());
+  std::vector<std::size_t> by_cost(ks.size());
+  for (std::size_t r = 0; r < ks.size(); ++r) by_cost[r] = r;
+  std::stable_sort(by_cost.begin(), by_cost.end(), [&](std::size_t a, std::size_t b) { return ks[a] > ks[b]; });
+
+  std::exception_ptr failure;
+  const auto count = static_cast<long>(ks.size());
+#pragma omp parallel for schedule(dynamic, 1)
+  for (long k = 0; k < count; ++k) {
+    const std::size_t r = by_cost[static_cast<std::size_t>(k)];
+    try {
+      cl::Particles particles = scene.particles;
+      cl::lab08::RunPlan plan;
+      plan.frames = scene.steps;
+      plan.window_frames = frames_in(lab.window_seconds, scene);
+      plan.settle_tolerance = lab.settle_tolerance;
+      results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
+    } catch (...) {
+#pragma omp critical(lab08_sweep_failure)
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+
+  cl::CsvTable table({"scene", "method", "dt", "substeps", "iterations", "frames_run", "time_run", "window_seconds",
+                      "steady_total_stretch", "material_total_stretch", "stiffness_ratio", "steady_max_strain",
+                      "window_spread", "max_energy_rise", "seconds", "status"});
+  std::printf("%s: %s on %s; each run until the mean total stretch of three %.3g s windows agrees to %.3g "
+              "(at most %d frames)\n",
+              kLab, options.method.c_str(), describe(scene).c_str(), lab.window_seconds, lab.settle_tolerance,
+              scene.steps);
+  if (hanging) std::printf("  hanging at rest with its springs' stiffness: total stretch %.6e m\n", *hanging);
+  std::printf("%10s %14s %12s %10s %8s %8s  %s\n", "iterations", "steady_stretch", "k_eff/k", "max_strain",
+              "spread", "t_run/s", "status");
+  for (std::size_t r = 0; r < ks.size(); ++r) {
+    const cl::lab08::RunResult& result = results[r];
+    const bool measured = result.problem.empty() && result.windows_done > 0;
+    auto value = [](bool known, double number) -> cl::CsvCell {
+      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
+    };
+    // k_eff / k: the stiffness the chain shows, relative to its material's
+    // (the hanging stretch is proportional to 1/k).
+    const bool ratio_known = measured && hanging && result.window_total_stretch > 0.0;
+    const double ratio = ratio_known ? *hanging / result.window_total_stretch : 0.0;
+    table.add_row({scene.name, options.method, scene.dt, static_cast<long long>(lab.substeps),
+                   static_cast<long long>(ks[r]), static_cast<long long>(result.frames_done),
+                   result.frames_done * scene.dt, frames_in(lab.window_seconds, scene) * scene.dt,
+                   value(measured, result.window_total_stretch), value(hanging.has_value(), hanging.value_or(0.0)),
+                   value(ratio_known, ratio), value(measured, result.window_max_strain),
+                   value(measured && result.window_spread >= 0.0, result.window_spread), result.max_energy_rise,
+                   result.seconds, status_of(result)});
+    if (measured) {
+      std::printf("%10d %14.6e %12.4g %10.3e %8.1e %8.2f  %s\n", ks[r], result.window_total_stretch,
+                  ratio_known ? ratio : std::nan(""), result.window_max_strain, result.window_spread,
+                  result.frames_done * scene.dt, status_of(result).c_str());
+    } else {
+      std::printf("%10d  %s\n", ks[r], result.problem.empty() ? "too short for one window" : status_of(result).c_str());
+    }
+  }
+  if (!options.out.empty()) {
+    table.write(cl::join_path(options.out, "stretch_vs_iterations_" + options.method + ".csv"));
+  }
+  return 0;
+}
+
+int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (lab.sweep_iterations.empty()) return run_one(options, lab);
+  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
+  return run_sweep(options, lab);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Lab 08: XPBD. Runs a scene with PBD (lab 04) or XPBD and writes per-frame strain, stretch and "
+               "energy and a summary with the multipliers; or sweeps the iteration count and writes the steady "
+               "stretch.",
+               CL_PROGRAM_NAME};
+  cl::CommonOptions options;
+  options.scene = "hanging-chain-20";
+  options.method = "xpbd";
+  options.methods = {"pbd", "xpbd"};
+  options.iterations = 10;
+  cl::add_common_options(app, options,
+                         cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
+                             cl::kFlagOut | cl::kFlagSummary);
+  LabOptions lab;
+  app.add_option("--substeps", lab.substeps, "steps of dt/n per frame")
+      ->check(CLI::Range(1, 1'000'000))
+      ->capture_default_str();
+  app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady stretch")
+      ->check(cl::finite_in(1e-9, 1e9))
+      ->capture_default_str();
+  app.add_option("--sweep-iterations", lab.sweep_iterations,
+                 "run the scene once per K in this list (e.g. 1,2,4,8) and write "
+                 "stretch_vs_iterations_<method>.csv; --steps is then the most frames a run may take to settle")
+      ->delimiter(',')
+      ->check(CLI::Range(0, 1'000'000));
+  app.add_option("--settle-tolerance", lab.settle_tolerance,
+                 "sweeps: a run has settled when the mean total stretch of its last three windows agree to this "
+                 "relative spread (0: run all --steps frames)")
+      ->check(cl::finite_in(0.0, 1e9))
+      ->capture_default_str();
+  return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
+}
