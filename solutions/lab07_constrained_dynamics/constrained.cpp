@@ -1,0 +1,228 @@
+// Lab 07 — reference solution.
+#include "constrained.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/SparseLU>
+
+namespace cl::lab07 {
+
+namespace {
+
+void check_springs(const char* function, Eigen::Index particle_count, const std::vector<Spring>& springs) {
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    const std::string where = std::string(function) + ": springs[" + std::to_string(e) + "]";
+    if (s.i < 0 || s.j < 0 || s.i >= particle_count || s.j >= particle_count) {
+      throw std::invalid_argument(where + " has an index out of range (" + std::to_string(s.i) + ", " +
+                                  std::to_string(s.j) + ") for " + std::to_string(particle_count) + " particles");
+    }
+    if (s.i == s.j) throw std::invalid_argument(where + " joins particle " + std::to_string(s.i) + " to itself");
+    if (!std::isfinite(s.rest_length) || s.rest_length < 0.0) {
+      throw std::invalid_argument(where + ".rest_length must be finite and >= 0 (got " +
+                                  std::to_string(s.rest_length) + ")");
+    }
+  }
+}
+
+void check_step(const char* function, const LinearizedStep& step) {
+  const Eigen::Index m = step.phi.size();
+  const Eigen::Index n3 = step.velocity.size();
+  if (step.jacobian.rows() != m || step.jacobian.cols() != n3 || step.inv_mass.size() != n3 || n3 % 3 != 0 ||
+      (step.compliance.size() != 0 && step.compliance.size() != m)) {
+    throw std::invalid_argument(std::string(function) + ": sizes disagree (phi " + std::to_string(m) +
+                                ", jacobian " + std::to_string(step.jacobian.rows()) + " x " +
+                                std::to_string(step.jacobian.cols()) + ", compliance " +
+                                std::to_string(step.compliance.size()) + ", inv_mass " +
+                                std::to_string(step.inv_mass.size()) + ", velocity " + std::to_string(n3) + ")");
+  }
+  if (!std::isfinite(step.dt) || !(step.dt > 0.0)) {
+    throw std::invalid_argument(std::string(function) + ": dt must be finite and > 0 (got " +
+                                std::to_string(step.dt) + ")");
+  }
+  for (Eigen::Index k = 0; k < n3; ++k) {
+    if (!std::isfinite(step.inv_mass[k]) || !(step.inv_mass[k] > 0.0)) {
+      throw std::invalid_argument(std::string(function) + ": inv_mass[" + std::to_string(k) +
+                                  "] must be finite and > 0 (got " + std::to_string(step.inv_mass[k]) + ")");
+    }
+  }
+}
+
+// max over rows of Σ_j |a_ij|, the infinity norm.
+double row_sum_norm(const SparseMatrix& a) {
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(a.rows());
+  for (int k = 0; k < a.outerSize(); ++k) {
+    for (SparseMatrix::InnerIterator it(a, k); it; ++it) sums[it.row()] += std::abs(it.value());
+  }
+  return a.rows() > 0 ? sums.maxCoeff() : 0.0;
+}
+
+// g repeated for every unknown.
+Eigen::VectorXd stacked_gravity(const LinearizedStep& step) {
+  return step.gravity.replicate(step.velocity.size() / 3, 1);
+}
+
+}  // namespace
+
+Eigen::VectorXd constraint_values(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs) {
+  check_springs("constraint_values", x.cols(), springs);
+  Eigen::VectorXd phi(static_cast<Eigen::Index>(springs.size()));
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    phi[static_cast<Eigen::Index>(e)] = (x.col(s.i) - x.col(s.j)).norm() - s.rest_length;
+  }
+  return phi;
+}
+
+SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs,
+                                 const MovableMap& map) {
+  check_springs("constraint_jacobian", x.cols(), springs);
+  if (static_cast<Eigen::Index>(map.unknown_of.size()) != x.cols()) {
+    throw std::invalid_argument("constraint_jacobian: the map is for " + std::to_string(map.unknown_of.size()) +
+                                " particles, x has " + std::to_string(x.cols()));
+  }
+  std::vector<Triplet> triplets;
+  triplets.reserve(6 * springs.size());
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    const Eigen::Vector3d d = x.col(s.i) - x.col(s.j);
+    const double length = d.norm();
+    if (!(length > 0.0)) continue;  // coincident: no direction, empty row
+    const Eigen::Vector3d n = d / length;
+    const int row = static_cast<int>(e);
+    const int ui = map.unknown_of[static_cast<std::size_t>(s.i)];
+    const int uj = map.unknown_of[static_cast<std::size_t>(s.j)];
+    for (int c = 0; c < 3; ++c) {
+      if (ui >= 0) triplets.emplace_back(row, 3 * ui + c, n[c]);
+      if (uj >= 0) triplets.emplace_back(row, 3 * uj + c, -n[c]);
+    }
+  }
+  return assemble(static_cast<Eigen::Index>(springs.size()), 3 * map.unknowns(), triplets);
+}
+
+KktSystem kkt_system(const LinearizedStep& step) {
+  check_step("kkt_system", step);
+  const Eigen::Index n3 = step.velocity.size();
+  const Eigen::Index m = step.phi.size();
+  const double dt = step.dt;
+  std::vector<Triplet> triplets;
+  triplets.reserve(static_cast<std::size_t>(n3 + 2 * step.jacobian.nonZeros() + step.compliance.size()));
+  for (Eigen::Index k = 0; k < n3; ++k) triplets.emplace_back(k, k, 1.0 / step.inv_mass[k]);
+  for (int e = 0; e < step.jacobian.outerSize(); ++e) {
+    for (SparseMatrix::InnerIterator it(step.jacobian, e); it; ++it) {
+      triplets.emplace_back(it.col(), n3 + it.row(), -dt * it.value());  // −ΔtJᵀ
+      triplets.emplace_back(n3 + it.row(), it.col(), dt * it.value());   // +ΔtJ
+    }
+  }
+  for (Eigen::Index e = 0; e < step.compliance.size(); ++e) {
+    if (step.compliance[e] != 0.0) triplets.emplace_back(n3 + e, n3 + e, step.compliance[e]);
+  }
+  KktSystem system;
+  system.matrix = assemble(n3 + m, n3 + m, triplets);
+  system.rhs.resize(n3 + m);
+  const Eigen::VectorXd predicted = step.velocity + dt * stacked_gravity(step);
+  system.rhs.head(n3) = predicted.cwiseQuotient(step.inv_mass);  // M(v + Δt g)
+  system.rhs.tail(m) = -step.phi;
+  return system;
+}
+
+StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) {
+  const Eigen::Index size = system.matrix.rows();
+  if (system.matrix.cols() != size || system.rhs.size() != size) {
+    throw std::invalid_argument("solve_kkt: the matrix is " + std::to_string(size) + " x " +
+                                std::to_string(system.matrix.cols()) + ", the right-hand side has " +
+                                std::to_string(system.rhs.size()) + " entries");
+  }
+  if (velocity_unknowns < 0 || velocity_unknowns > size) {
+    throw std::invalid_argument("solve_kkt: velocity_unknowns " + std::to_string(velocity_unknowns) +
+                                " is outside [0, " + std::to_string(size) + "]");
+  }
+  StepSolution solution;
+  // LU with partial pivoting: correct for a non-symmetric, indefinite matrix.
+  Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
+  lu.analyzePattern(system.matrix);
+  lu.factorize(system.matrix);
+  if (lu.info() != Eigen::Success) {
+    solution.problem = "the KKT matrix is singular (LU failed: " + lu.lastErrorMessage() + ")";
+    return solution;
+  }
+  const Eigen::VectorXd unknowns = lu.solve(system.rhs);
+  if (lu.info() != Eigen::Success || !unknowns.allFinite()) {
+    solution.problem = "the KKT matrix is singular (the LU solve is not finite)";
+    return solution;
+  }
+  // A pivot that is zero only up to round-off gives a finite answer; when the
+  // system has no solution that answer does not satisfy it.
+  const double residual = (system.matrix * unknowns - system.rhs).cwiseAbs().maxCoeff();
+  if (size > 0 && !(residual <= 1e-8 * (row_sum_norm(system.matrix) * unknowns.cwiseAbs().maxCoeff() +
+                                         system.rhs.cwiseAbs().maxCoeff()))) {
+    solution.problem = "the KKT matrix is singular (the LU solution misses the system by " +
+                       std::to_string(residual) + ")";
+    return solution;
+  }
+  solution.velocity = unknowns.head(velocity_unknowns);
+  solution.lambda = unknowns.tail(size - velocity_unknowns);
+  solution.ok = true;
+  return solution;
+}
+
+StepSolution solve_schur(const LinearizedStep& step) {
+  check_step("solve_schur", step);
+  const Eigen::Index m = step.phi.size();
+  const double dt = step.dt;
+  const Eigen::VectorXd predicted = step.velocity + dt * stacked_gravity(step);  // v + Δt g
+  StepSolution solution;
+  if (m == 0) {
+    solution.velocity = predicted;
+    solution.lambda.resize(0);
+    solution.ok = true;
+    return solution;
+  }
+  const SparseMatrix weighted = step.inv_mass.asDiagonal() * SparseMatrix(step.jacobian.transpose());  // W Jᵀ
+  SparseMatrix schur = (dt * dt) * (step.jacobian * weighted);
+  if (step.compliance.size() != 0) {
+    std::vector<Triplet> diagonal;
+    for (Eigen::Index e = 0; e < m; ++e) {
+      if (step.compliance[e] != 0.0) diagonal.emplace_back(e, e, step.compliance[e]);
+    }
+    schur += assemble(m, m, diagonal);
+  }
+  SpdFactorization factor;
+  if (!factor.factor(schur)) {
+    solution.problem =
+        "the Schur complement dt^2 J W J^T + C is singular (redundant hard constraints, or a hard constraint "
+        "that nothing can move)";
+    return solution;
+  }
+  const Eigen::VectorXd rhs = -step.phi - dt * (step.jacobian * predicted);
+  solution.lambda = factor.solve(rhs);
+  solution.velocity = predicted + dt * (weighted * solution.lambda);
+  if (!solution.lambda.allFinite() || !solution.velocity.allFinite()) {
+    solution.velocity.resize(0);
+    solution.lambda.resize(0);
+    solution.problem = "the Schur solve is not finite";
+    return solution;
+  }
+  solution.ok = true;
+  return solution;
+}
+
+void update_positions(Particles& particles, const MovableMap& map, const Eigen::VectorXd& velocity, double dt) {
+  const Eigen::Index n = particles.size();
+  if (!std::isfinite(dt) || !(dt > 0.0)) {
+    throw std::invalid_argument("update_positions: dt must be finite and > 0 (got " + std::to_string(dt) + ")");
+  }
+  if (particles.v.cols() != n || static_cast<Eigen::Index>(map.unknown_of.size()) != n ||
+      velocity.size() != 3 * map.unknowns()) {
+    throw std::invalid_argument("update_positions: " + std::to_string(n) + " particles, a map of " +
+                                std::to_string(map.unknown_of.size()) + " with " + std::to_string(map.unknowns()) +
+                                " unknowns, and " + std::to_string(velocity.size()) + " velocity entries disagree");
+  }
+  particles.v.setZero();
+  scatter_stacked(velocity, map, particles.v);
+  particles.x += dt * particles.v;  // pinned columns have v = 0
+}
+
+}  // namespace cl::lab07
