@@ -1,5 +1,6 @@
 #include "common/sparse.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -72,7 +73,38 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
     throw std::invalid_argument("SpdFactorization::factor: the matrix is " + std::to_string(a.rows()) + " x " +
                                 std::to_string(a.cols()) + ", not square");
   }
-  ldlt_.compute(a);
+  SparseMatrix copy;
+  const SparseMatrix* matrix = &a;
+  if (!a.isCompressed()) {
+    copy = a;
+    copy.makeCompressed();
+    matrix = &copy;
+  }
+  ldlt_.analyzePattern(*matrix);
+  analyzed_outer_.assign(matrix->outerIndexPtr(), matrix->outerIndexPtr() + matrix->outerSize() + 1);
+  analyzed_inner_.assign(matrix->innerIndexPtr(), matrix->innerIndexPtr() + matrix->nonZeros());
+  ldlt_.factorize(*matrix);
+  return accept_pivots(a.rows());
+}
+
+bool SpdFactorization::same_pattern(const SparseMatrix& a) const {
+  if (a.rows() != a.cols() || a.outerSize() + 1 != static_cast<Eigen::Index>(analyzed_outer_.size())) return false;
+  if (!a.isCompressed()) return false;
+  return std::equal(analyzed_outer_.begin(), analyzed_outer_.end(), a.outerIndexPtr()) &&
+         a.nonZeros() == static_cast<Eigen::Index>(analyzed_inner_.size()) &&
+         std::equal(analyzed_inner_.begin(), analyzed_inner_.end(), a.innerIndexPtr());
+}
+
+bool SpdFactorization::refactor(const SparseMatrix& a) {
+  if (analyzed_outer_.empty() || !same_pattern(a)) return factor(a);
+  ++factorizations_;
+  ok_ = false;
+  size_ = 0;
+  ldlt_.factorize(a);
+  return accept_pivots(a.rows());
+}
+
+bool SpdFactorization::accept_pivots(Eigen::Index rows) {
   if (ldlt_.info() != Eigen::Success) return false;
   const Eigen::VectorXd& d = ldlt_.vectorD();
   // A pivot that is not clearly positive means A is singular or indefinite to
@@ -83,7 +115,7 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
     if (!std::isfinite(d[k]) || !(d[k] > floor)) return false;
   }
   ok_ = true;
-  size_ = a.rows();
+  size_ = rows;
   return true;
 }
 

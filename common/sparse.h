@@ -53,6 +53,12 @@ class SpdFactorization {
   // precision (a pivot of D that is not finite and > 0), e.g. a singular Schur
   // complement. Counts every call in factorizations().
   bool factor(const SparseMatrix& a);
+  // The same for a matrix whose values changed but whose sparsity pattern did
+  // not (Newton's Hessian, a KKT matrix): the ordering and symbolic analysis
+  // of the last factor() are reused and only the numeric factorization is
+  // redone. When the pattern differs (or nothing was factored yet) it is
+  // factor(a). Counts in factorizations() like factor().
+  bool refactor(const SparseMatrix& a);
   bool ok() const { return ok_; }
   int factorizations() const { return factorizations_; }
   Eigen::Index size() const { return size_; }
@@ -70,11 +76,15 @@ class SpdFactorization {
 
  private:
   void require_factor(Eigen::Index rows) const;
+  bool same_pattern(const SparseMatrix& a) const;
+  bool accept_pivots(Eigen::Index rows);
 
   Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
   bool ok_ = false;
   int factorizations_ = 0;
   Eigen::Index size_ = 0;
+  // The pattern the symbolic analysis was made for (compressed column arrays).
+  std::vector<int> analyzed_outer_, analyzed_inner_;
 };
 
 }  // namespace cl

@@ -98,3 +98,24 @@ TEST_CASE("a singular or indefinite matrix is refused, not factored into NaN", "
   CHECK_FALSE(factor.factor(indefinite));
   CHECK(factor.factorizations() == 2);
 }
+
+TEST_CASE("refactor reuses the analysis for the same pattern and falls back for another", "[sparse]") {
+  std::mt19937_64 rng(11);
+  const cl::SparseMatrix a = random_spd(rng, 80);
+  cl::SparseMatrix scaled = a;  // same pattern, other values (still SPD)
+  for (Eigen::Index k = 0; k < scaled.nonZeros(); ++k) scaled.valuePtr()[k] *= 1.0 + 0.01 * static_cast<double>(k % 7);
+  scaled.diagonal() += Eigen::VectorXd::Constant(80, 50.0);
+  const cl::RowsX3 b = cl::RowsX3::Random(80, 3);
+  cl::SpdFactorization factor;
+  REQUIRE(factor.refactor(a));  // nothing analysed yet: a plain factor()
+  REQUIRE(factor.refactor(scaled));
+  const Eigen::MatrixXd expected = Eigen::MatrixXd(scaled).ldlt().solve(Eigen::MatrixXd(b));
+  CHECK_THAT((Eigen::MatrixXd(factor.solve3(b)) - expected).cwiseAbs().maxCoeff(),
+             WithinAbs(0.0, 1e-10 * expected.cwiseAbs().maxCoeff()));
+  const cl::SparseMatrix other = random_spd(rng, 80);  // another pattern
+  REQUIRE(factor.refactor(other));
+  const Eigen::MatrixXd other_expected = Eigen::MatrixXd(other).ldlt().solve(Eigen::MatrixXd(b));
+  CHECK_THAT((Eigen::MatrixXd(factor.solve3(b)) - other_expected).cwiseAbs().maxCoeff(),
+             WithinAbs(0.0, 1e-10 * other_expected.cwiseAbs().maxCoeff()));
+  CHECK(factor.factorizations() == 3);
+}

@@ -1,0 +1,101 @@
+"""Lab 06 figure and table: time to a relative objective error, PD against Newton, per size.
+
+Usage: /usr/bin/python3 plots/lab06_crossover.py OUTDIR
+Reads OUTDIR/lab06_projective_dynamics/crossover.csv (the --convergence line of
+labs/lab06_projective_dynamics/demo.txt) and writes next to it:
+  crossover.png   seconds to reach (g - g*)/g* = 1e-2, 1e-3, 1e-6 against the number of
+                  unknowns, one panel per target, log-log; PD with and without its factorization
+  crossover.md    the same numbers as a table, with iterations and factorizations
+Exit 4 when the data are absent.
+"""
+import csv
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+LAB = "lab06_projective_dynamics"
+COMMAND = ("./course run lab06_solution --convergence --sweep-scenes "
+           "pd-curtain-16,pd-curtain-32,pd-curtain-64,pd-curtain-128 --out out/lab06_projective_dynamics "
+           "(or ./course demo)")
+
+
+def read_rows(path):
+    with open(path, newline="") as handle:
+        return list(csv.DictReader(handle))
+
+
+def figure(rows, path):
+    targets = sorted({float(row["target"]) for row in rows}, reverse=True)
+    plot, axes = plt.subplots(1, len(targets), figsize=(5 * len(targets), 4.5), squeeze=False)
+    for axis, target in zip(axes[0], targets):
+        missing = []
+        for method, color, marker in (("pd", "tab:blue", "s"), ("newton", "tab:red", "o")):
+            chosen = [row for row in rows if row["method"] == method and float(row["target"]) == target]
+            reached = [row for row in chosen if row["reached"] == "yes"]
+            sizes = [int(row["unknowns"]) for row in reached]
+            axis.loglog(sizes, [float(row["seconds"]) for row in reached], marker=marker, color=color,
+                        label=f"{method}" + (" (with its factorization)" if method == "pd" else ""))
+            if method == "pd":
+                axis.loglog(sizes, [max(float(row["seconds_without_setup"]), 1e-7) for row in reached],
+                            marker=marker, color=color, linestyle=":", fillstyle="none",
+                            label="pd, factorization amortised")
+            missing.extend((row, color) for row in chosen if row["reached"] != "yes")
+        top = axis.get_ylim()[1]
+        for row, color in missing:
+            axis.annotate(f"{row['method']}: " + ("not reached" if row["reached"] == "no" else "undecided"),
+                          (int(row["unknowns"]), top), color=color, fontsize=7, rotation=90, va="top",
+                          ha="center")
+        axis.set_title(f"(g - g*)/g* <= {target:g}")
+        axis.set_xlabel("unknowns (movable particles)")
+        axis.set_ylabel("wall time of the step (s)")
+        axis.grid(True, which="major", alpha=0.3)
+        axis.legend(fontsize=7)
+    plot.suptitle("Lab 06: time to an accuracy, one step of the curtains (labels: runs that did not get there)")
+    plot.tight_layout()
+    plot.savefig(path, dpi=120)
+    plt.close(plot)
+
+
+def table(rows, path):
+    lines = ["| scene | unknowns | target | PD: iterations, s (s without the factorization) | "
+             "Newton: iterations = factorizations, s |", "|---|---:|---:|---|---|"]
+    keys = sorted({(int(row["unknowns"]), row["scene"], float(row["target"])) for row in rows},
+                  key=lambda key: (key[0], -key[2]))
+    for unknowns, scene, target in keys:
+        cells = {}
+        for row in rows:
+            if row["scene"] == scene and float(row["target"]) == target:
+                if row["reached"] != "yes":
+                    cells[row["method"]] = row["reached"].replace("no", "not reached")
+                elif row["method"] == "pd":
+                    cells["pd"] = (f"{row['iterations']}, {float(row['seconds']):.3g} "
+                                   f"({float(row['seconds_without_setup']):.3g})")
+                else:
+                    cells["newton"] = f"{row['iterations']}, {float(row['seconds']):.3g}"
+        lines.append(f"| {scene} | {unknowns} | {target:g} | {cells.get('pd', '-')} | {cells.get('newton', '-')} |")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def main(argv):
+    if len(argv) != 2:
+        print("usage: plots/lab06_crossover.py OUTDIR", file=sys.stderr)
+        return 2
+    source = Path(argv[1]) / LAB / "crossover.csv"
+    if not source.is_file():
+        print(f"lab06_crossover: {source} is missing; make it with {COMMAND}", file=sys.stderr)
+        return 4
+    rows = read_rows(source)
+    figure(rows, source.parent / "crossover.png")
+    table(rows, source.parent / "crossover.md")
+    wrinkled = source.parent / "wrinkled" / "crossover.csv"
+    if wrinkled.is_file():
+        table(read_rows(wrinkled), wrinkled.parent / "crossover.md")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
