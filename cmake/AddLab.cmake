@@ -3,21 +3,42 @@
 #
 # Files by convention, all under labs/NAME unless said otherwise:
 #   STUDENT   the student's .cpp stubs; solutions/NAME holds a reference .cpp of
-#             the same name for each
+#             the same name for each (in a student release: only for the labs
+#             before the current one, see docs/DESIGN.md §4)
 #   SUPPORT   lab code that is not the student's (used by the driver and tests)
 #   LIBRARIES extra link targets for the lab's code (e.g. OpenMP::OpenMP_CXX)
 #   main.cpp  the executable's driver
 #   scenes/   the lab's JSON scenes
-#   tests/NAME/*.cpp  the graded tests
+#   tests/NAME/*.cpp       the graded tests
+#   tests/NAME/info/*.cpp  optional: an ungraded measurement the grader prints
+#                          (e.g. lab 03's OpenMP speed-up)
 #
+# A lab HAS A REFERENCE when every one of its STUDENT files is in solutions/NAME.
 # Targets:
-#   NAME_student, NAME_reference   the two implementations (static libraries)
-#   NAME, NAME_solution            the executables, in build/bin
-#   NAME_tests                     graded tests: this lab's student code, earlier
-#                                  labs' reference code (isolation, COURSE.md §4)
-#   NAME_tests_solution            graded tests against reference code throughout
+#   NAME_student                   the student's code (static library)
+#   NAME, NAME_tests               the executable and the graded tests, in build/bin.
+#                                  NAME links the student's code all the way down;
+#                                  NAME_tests links this lab's student code and, for
+#                                  each earlier lab, its reference when it has one,
+#                                  else the student's code (isolation, docs/DESIGN.md §4)
+#   NAME_info                      the info program, linked like NAME_tests
+#   NAME_tests_asan                NAME_tests with the tests and the student's code
+#                                  under -fsanitize=address,undefined (not built by
+#                                  default; the grader reruns a crashed case in it)
+# Only for a lab with a reference:
+#   NAME_reference                 the reference code (static library)
+#   NAME_solution, NAME_tests_solution, NAME_info_solution   the same, reference throughout
+#
 # Drivers see CL_LAB_NAME (the lab, for summaries), CL_PROGRAM_NAME (the
 # executable, for messages) and CL_LAB_SCENE_DIR (absolute path of scenes/).
+#
+# The build writes ${PROJECT_BINARY_DIR}/labs.json, read by tools/course.py: per
+# lab its student files, whether it has a reference, its earlier labs and
+# whether the graded tests link each one's reference or the student's code.
+
+set_property(GLOBAL PROPERTY CL_LAB_MANIFEST "")
+set(CL_SANITIZE_FLAGS -fsanitize=address,undefined -g -O1 -fno-omit-frame-pointer)
+
 function(add_lab name)
   cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS;LIBRARIES" ${ARGN})
   set(lab_dir "${PROJECT_SOURCE_DIR}/labs/${name}")
@@ -33,15 +54,38 @@ function(add_lab name)
   list(SORT closure ORDER DESCENDING)
   set_property(GLOBAL PROPERTY CL_LAB_CLOSURE_${name} ${closure})
 
+  # A reference exists when all of the student files are in solutions/NAME; some
+  # but not all is a broken tree, not a release.
   set(student_sources "")
   set(reference_sources "")
+  set(present "")
+  set(absent "")
   foreach(file IN LISTS LAB_STUDENT)
     list(APPEND student_sources "${lab_dir}/${file}")
     list(APPEND reference_sources "${solution_dir}/${file}")
-    if(CL_HAVE_SOLUTIONS AND NOT EXISTS "${solution_dir}/${file}")
-      message(FATAL_ERROR "${name}: solutions/${name}/${file} is missing")
+    if(EXISTS "${solution_dir}/${file}")
+      list(APPEND present ${file})
+    else()
+      list(APPEND absent ${file})
     endif()
   endforeach()
+  if(present AND absent)
+    message(FATAL_ERROR "${name}: solutions/${name} has ${present} but not ${absent}")
+  endif()
+  if(absent)
+    set(has_reference OFF)
+  else()
+    set(has_reference ON)
+  endif()
+  set_property(GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${name} ${has_reference})
+  # Re-configure when a reference arrives (a past lab's solution, released late).
+  if(EXISTS "${PROJECT_SOURCE_DIR}/solutions")
+    set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS
+                 "${PROJECT_SOURCE_DIR}/solutions")
+  endif()
+  if(EXISTS "${solution_dir}")
+    set_property(DIRECTORY "${PROJECT_SOURCE_DIR}" APPEND PROPERTY CMAKE_CONFIGURE_DEPENDS "${solution_dir}")
+  endif()
 
   if(LAB_SUPPORT)
     list(TRANSFORM LAB_SUPPORT PREPEND "${lab_dir}/")
@@ -56,7 +100,7 @@ function(add_lab name)
 
   add_library(${name}_student STATIC ${student_sources})
   target_link_libraries(${name}_student PUBLIC ${name}_support)
-  if(CL_HAVE_SOLUTIONS)
+  if(has_reference)
     add_library(${name}_reference STATIC ${reference_sources})
     target_link_libraries(${name}_reference PUBLIC ${name}_support)
     # The reference includes the header beside the stub: one contract, no drift.
@@ -75,13 +119,25 @@ function(add_lab name)
   set(student_chain ${name}_support ${name}_student)
   set(reference_chain ${name}_support ${name}_reference)
   set(isolated_chain ${name}_support ${name}_student)
+  set(links_json "")
   foreach(dep IN LISTS closure)
+    get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
     list(APPEND student_chain ${dep}_support ${dep}_student)
     list(APPEND reference_chain ${dep}_support ${dep}_reference)
-    if(CL_HAVE_SOLUTIONS)
+    if(dep_has_reference)
       list(APPEND isolated_chain ${dep}_support ${dep}_reference)
+      list(APPEND links_json "\"${dep}\": \"reference\"")
     else()
       list(APPEND isolated_chain ${dep}_support ${dep}_student)
+      list(APPEND links_json "\"${dep}\": \"student\"")
+    endif()
+  endforeach()
+  # A lab with a reference can only have earlier labs with references (a
+  # release ships the past ones, the full tree all of them).
+  foreach(dep IN LISTS closure)
+    get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
+    if(has_reference AND NOT dep_has_reference)
+      message(FATAL_ERROR "${name} has a reference in solutions/ but ${dep}, which it needs, has none")
     endif()
   endforeach()
 
@@ -99,7 +155,31 @@ function(add_lab name)
   target_compile_definitions(${name}_tests PRIVATE ${scene_definition})
   set_target_properties(${name}_tests PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
-  if(CL_HAVE_SOLUTIONS)
+  # The grader's crash rerun (not built by default): the graded tests and this
+  # lab's student code compiled with AddressSanitizer and UBSan; everything
+  # else links as in NAME_tests, uninstrumented, so only a few files compile.
+  add_executable(${name}_tests_asan EXCLUDE_FROM_ALL ${test_sources} ${student_sources})
+  target_link_libraries(${name}_tests_asan PRIVATE catch_main ${name}_support)
+  list(LENGTH isolated_chain chain_length)
+  if(chain_length GREATER 2)
+    list(SUBLIST isolated_chain 2 -1 earlier_chain)
+    target_link_libraries(${name}_tests_asan PRIVATE ${earlier_chain})
+  endif()
+  target_link_libraries(${name}_tests_asan PRIVATE common)
+  target_compile_definitions(${name}_tests_asan PRIVATE ${scene_definition})
+  target_compile_options(${name}_tests_asan PRIVATE ${CL_SANITIZE_FLAGS})
+  target_link_options(${name}_tests_asan PRIVATE -fsanitize=address,undefined)
+  set_target_properties(${name}_tests_asan PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
+
+  file(GLOB info_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/info/*.cpp")
+  if(info_sources)
+    add_executable(${name}_info ${info_sources})
+    target_link_libraries(${name}_info PRIVATE ${isolated_chain} common)
+    target_compile_definitions(${name}_info PRIVATE ${scene_definition})
+    set_target_properties(${name}_info PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
+  endif()
+
+  if(has_reference)
     add_executable(${name}_solution "${lab_dir}/main.cpp")
     target_link_libraries(${name}_solution PRIVATE ${reference_chain} common)
     target_compile_definitions(${name}_solution PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}_solution")
@@ -109,5 +189,46 @@ function(add_lab name)
     target_link_libraries(${name}_tests_solution PRIVATE catch_main ${reference_chain} common)
     target_compile_definitions(${name}_tests_solution PRIVATE ${scene_definition})
     set_target_properties(${name}_tests_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
+
+    if(info_sources)
+      add_executable(${name}_info_solution ${info_sources})
+      target_link_libraries(${name}_info_solution PRIVATE ${reference_chain} common)
+      target_compile_definitions(${name}_info_solution PRIVATE ${scene_definition})
+      set_target_properties(${name}_info_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
+    endif()
   endif()
+
+  # This lab's entry in labs.json.
+  set(student_json "")
+  foreach(file IN LISTS LAB_STUDENT)
+    list(APPEND student_json "\"labs/${name}/${file}\"")
+  endforeach()
+  set(deps_json "")
+  foreach(dep IN LISTS closure)
+    list(APPEND deps_json "\"${dep}\"")
+  endforeach()
+  if(has_reference)
+    set(reference_json true)
+  else()
+    set(reference_json false)
+  endif()
+  if(info_sources)
+    set(info_json true)
+  else()
+    set(info_json false)
+  endif()
+  list(JOIN student_json ", " student_json)
+  list(JOIN deps_json ", " deps_json)
+  list(JOIN links_json ", " links_json)
+  set_property(GLOBAL APPEND PROPERTY CL_LAB_MANIFEST
+    "    \"${name}\": {\"student\": [${student_json}], \"reference\": ${reference_json}, \"info\": ${info_json},\n      \"deps\": [${deps_json}], \"links\": {${links_json}}}")
 endfunction()
+
+# Called once the whole CMakeLists.txt is read (cmake_language DEFER): labs.json.
+function(_cl_write_lab_manifest)
+  get_property(entries GLOBAL PROPERTY CL_LAB_MANIFEST)
+  list(JOIN entries ",\n" body)
+  file(CONFIGURE OUTPUT "${PROJECT_BINARY_DIR}/labs.json"
+       CONTENT "{\n  \"labs\": {\n${body}\n  }\n}\n" @ONLY)
+endfunction()
+cmake_language(DEFER CALL _cl_write_lab_manifest)
