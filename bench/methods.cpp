@@ -1,0 +1,226 @@
+#include "methods.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "common/hierarchy.h"
+#include "common/sparse.h"
+// Several labs have a simulation.h: every lab header is named by its path.
+#include "labs/lab04_pbd/pbd.h"
+#include "labs/lab05_strain_limiting/simulation.h"
+#include "labs/lab06_projective_dynamics/simulation.h"
+#include "labs/lab07_constrained_dynamics/step.h"
+#include "labs/lab08_xpbd/xpbd.h"
+#include "labs/lab09_stable_constrained/stable_step.h"
+#include "labs/lab10_hierarchical_pbd/simulation.h"
+
+namespace cl::bench {
+
+const char* family_name(Family family) {
+  switch (family) {
+    case Family::kHard: return "hard";
+    case Family::kImplicitEuler: return "implicit-euler";
+    case Family::kLinearized: return "linearized";
+    case Family::kLimited: return "limited";
+  }
+  return "?";
+}
+
+const std::vector<MethodInfo>& all_methods() {
+  static const std::vector<MethodInfo> methods{
+      {"gs-pbd", "lab04", Family::kHard, true, false},
+      {"jacobi-pbd", "lab04", Family::kHard, true, false},
+      {"hpbd", "lab10", Family::kHard, true, true},
+      {"xpbd", "lab08", Family::kImplicitEuler, true, false},
+      {"pd", "lab06", Family::kImplicitEuler, true, false},
+      {"newton", "lab06", Family::kImplicitEuler, true, false},
+      {"kkt", "lab07", Family::kLinearized, false, false},
+      {"schur", "lab07", Family::kLinearized, false, false},
+      {"schur-kg", "lab09", Family::kLinearized, false, false},
+      {"limit-springs", "lab05", Family::kLimited, true, false},
+      {"limit-triangles", "lab05", Family::kLimited, true, false},
+  };
+  return methods;
+}
+
+const MethodInfo& method_info(const std::string& name) {
+  for (const MethodInfo& method : all_methods()) {
+    if (method.name == name) return method;
+  }
+  std::string known;
+  for (const MethodInfo& method : all_methods()) known += (known.empty() ? "" : ", ") + method.name;
+  throw std::invalid_argument("unknown method '" + name + "' (one of " + known + ")");
+}
+
+double elastic_energy(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs) {
+  double energy = 0.0;
+  for (const Spring& spring : springs) {
+    if (!std::isfinite(spring.stiffness)) continue;
+    const double stretch = (x.col(spring.i) - x.col(spring.j)).norm() - spring.rest_length;
+    energy += 0.5 * spring.stiffness * stretch * stretch;
+  }
+  return energy;
+}
+
+namespace {
+
+class PbdStepper : public Stepper {
+ public:
+  PbdStepper(const Scene& scene, int iterations, lab04::Projection projection)
+      : constraints_(lab04::make_constraint_set(scene.particles.size(), scene.springs)) {
+    settings_.dt = scene.dt;
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+    settings_.projection = projection;
+  }
+  StepOutcome step(Particles& particles) override {
+    lab04::pbd_step(particles, constraints_, settings_);
+    return {{}, settings_.iterations};
+  }
+
+ private:
+  lab04::ConstraintSet constraints_;
+  lab04::PbdSettings settings_;
+};
+
+class HpbdStepper : public Stepper {
+ public:
+  HpbdStepper(const Scene& scene, int iterations) {
+    if (scene.grid_nx < 2 || scene.grid_ny < 2) {
+      throw std::invalid_argument("hpbd: the scene is not a cloth grid (lab 10 builds its hierarchy on one)");
+    }
+    const int levels = std::min(3, max_levels(scene.grid_nx, scene.grid_ny));
+    hierarchy_ = build_cloth_hierarchy(scene.grid_nx, scene.grid_ny, scene.particles.x, scene.particles.inv_mass,
+                                       scene.springs, levels);
+    settings_.dt = scene.dt;
+    settings_.gravity = scene.gravity;
+    settings_.iterations.assign(static_cast<std::size_t>(levels), iterations);
+  }
+  StepOutcome step(Particles& particles) override {
+    lab10::hpbd_step(particles, hierarchy_, settings_);
+    return {{}, settings_.iterations.front()};
+  }
+
+ private:
+  ClothHierarchy hierarchy_;
+  lab10::HpbdSettings settings_;
+};
+
+class XpbdStepper : public Stepper {
+ public:
+  XpbdStepper(const Scene& scene, int iterations)
+      : constraints_(lab04::make_constraint_set(scene.particles.size(), scene.springs)) {
+    for (const Spring& spring : scene.springs) lab08::compliance(spring);  // rejects a bad stiffness now
+    settings_.dt = scene.dt;
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+  }
+  StepOutcome step(Particles& particles) override {
+    lab08::xpbd_step(particles, constraints_, settings_, lambda_);
+    return {{}, settings_.iterations};
+  }
+
+ private:
+  lab04::ConstraintSet constraints_;
+  lab08::XpbdSettings settings_;
+  Eigen::VectorXd lambda_;
+};
+
+class ImplicitEulerStepper : public Stepper {
+ public:
+  ImplicitEulerStepper(const Scene& scene, int iterations, lab06::Method method)
+      : solver_(lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt), method) {
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+  }
+  StepOutcome step(Particles& particles) override {
+    const lab06::StepReport report = solver_.step(particles, settings_);
+    return {report.problem, report.iterations_done};
+  }
+
+ private:
+  lab06::Solver solver_;
+  lab06::StepSettings settings_;
+};
+
+class ConstrainedStepper : public Stepper {
+ public:
+  ConstrainedStepper(const Scene& scene, lab07::Method method)
+      : springs_(scene.springs), map_(make_movable_map(scene.particles.inv_mass)) {
+    lab07::compliance_of(springs_);  // rejects a bad stiffness now
+    settings_.dt = scene.dt;
+    settings_.gravity = scene.gravity;
+    settings_.method = method;
+  }
+  StepOutcome step(Particles& particles) override {
+    const lab07::StepResult result = lab07::constrained_step(particles, springs_, map_, settings_);
+    return {result.ok ? std::string() : result.problem, 1};
+  }
+
+ private:
+  std::vector<Spring> springs_;
+  MovableMap map_;
+  lab07::StepSettings settings_;
+};
+
+class StableStepper : public Stepper {
+ public:
+  explicit StableStepper(const Scene& scene)
+      : springs_(scene.springs), map_(make_movable_map(scene.particles.inv_mass)) {
+    lab07::compliance_of(springs_);
+    settings_.step.dt = scene.dt;
+    settings_.step.gravity = scene.gravity;
+    settings_.step.method = lab07::Method::kSchur;
+  }
+  StepOutcome step(Particles& particles) override {
+    const lab09::StableStepResult result = lab09::stable_step(particles, springs_, map_, settings_, lambda_);
+    if (!result.ok) return {result.problem, 1};
+    lambda_ = result.lambda;
+    return {{}, 1};
+  }
+
+ private:
+  std::vector<Spring> springs_;
+  MovableMap map_;
+  lab09::StableSettings settings_;
+  Eigen::VectorXd lambda_;
+};
+
+class LimitedStepper : public Stepper {
+ public:
+  LimitedStepper(const Scene& scene, int iterations, lab05::Limit limit)
+      : system_(lab05::make_limited_system(scene, limit)) {
+    settings_.dt = scene.dt;
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+    settings_.limit = limit;
+  }
+  StepOutcome step(Particles& particles) override {
+    lab05::limited_step(particles, system_, settings_);
+    return {{}, settings_.iterations};
+  }
+
+ private:
+  lab05::LimitedSystem system_;
+  lab05::StepSettings settings_;
+};
+
+}  // namespace
+
+std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations) {
+  const std::string& name = method_info(method).name;
+  if (name == "gs-pbd") return std::make_unique<PbdStepper>(scene, iterations, lab04::Projection::kGaussSeidel);
+  if (name == "jacobi-pbd") return std::make_unique<PbdStepper>(scene, iterations, lab04::Projection::kJacobi);
+  if (name == "hpbd") return std::make_unique<HpbdStepper>(scene, iterations);
+  if (name == "xpbd") return std::make_unique<XpbdStepper>(scene, iterations);
+  if (name == "pd") return std::make_unique<ImplicitEulerStepper>(scene, iterations, lab06::Method::kProjectiveDynamics);
+  if (name == "newton") return std::make_unique<ImplicitEulerStepper>(scene, iterations, lab06::Method::kNewton);
+  if (name == "kkt") return std::make_unique<ConstrainedStepper>(scene, lab07::Method::kKkt);
+  if (name == "schur") return std::make_unique<ConstrainedStepper>(scene, lab07::Method::kSchur);
+  if (name == "schur-kg") return std::make_unique<StableStepper>(scene);
+  if (name == "limit-springs") return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kSprings);
+  return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kTrianglesStretch);
+}
+
+}  // namespace cl::bench

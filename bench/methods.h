@@ -1,0 +1,65 @@
+#pragma once
+// The step of every solver of labs 04-10 behind one interface, for the two
+// cross-lab programs (trade.cpp: the speed/accuracy trade; extremes.cpp: the
+// stability matrix). Each wraps a lab's REFERENCE code and keeps what that
+// lab's own loop keeps between steps (XPBD's multipliers, lab 09's previous
+// λ, PD's factor). What each family solves is in bench/README.md.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/constraints.h"
+#include "common/particles.h"
+#include "common/scene.h"
+
+namespace cl::bench {
+
+// What a method's step converges to (bench/README.md, "Which problem"):
+//   hard           PBD (GS, Jacobi, hierarchical): every spring a hard constraint;
+//   implicit-euler PD, Newton and XPBD: implicit Euler with spring energy ½ k φ²;
+//   linearized     KKT, Schur, Schur with geometric stiffness (lab 09): one
+//                  solve of implicit Euler with the constraints linearised;
+//   limited        lab 05: explicit springs and a strain limiter.
+enum class Family { kHard, kImplicitEuler, kLinearized, kLimited };
+const char* family_name(Family family);
+
+struct MethodInfo {
+  std::string name;   // e.g. "gs-pbd"
+  std::string lab;    // e.g. "lab04"
+  Family family = Family::kHard;
+  bool iterative = true;   // false: a direct solve; the iteration count is not used
+  bool grid_only = false;  // needs a cloth grid (the hierarchy of lab 10)
+};
+
+// Every method, in the order of the tables: gs-pbd, jacobi-pbd, hpbd, xpbd,
+// pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles.
+const std::vector<MethodInfo>& all_methods();
+// Throws std::invalid_argument for an unknown name (the message lists them).
+const MethodInfo& method_info(const std::string& name);
+
+struct StepOutcome {
+  std::string problem;  // non-empty: the lab's step said it could not be done
+  int iterations = 0;   // iterations (sweeps, PD or Newton iterations) done; 1 for a direct solve
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  // One step of the scene's dt from `particles` (updated in place).
+  virtual StepOutcome step(Particles& particles) = 0;
+};
+
+// The method's solver for `scene`: its springs, triangles, grid, gravity and
+// dt; the current positions of scene.particles are the rest shape where the
+// method needs one (lab 10's hierarchy, lab 05's triangles). `iterations` is
+// K (sweeps per level for hpbd; the most iterations for newton).
+// Throws std::invalid_argument or cl::InputError, with the lab's message,
+// when the method does not take the scene (e.g. PD and a hard spring).
+std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations);
+
+// Σ ½ k φ² over the springs of finite stiffness (J).
+double elastic_energy(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs);
+
+}  // namespace cl::bench

@@ -1,0 +1,535 @@
+// The speed/accuracy trade (issue 12, docs/DESIGN.md §5): every method on the
+// same scenes over a range of iteration counts. Per run: wall time per step
+// (median of repeats), strain error, distance to a converged reference step,
+// and the energy drift over a fixed horizon. What each number means, and which
+// problem each method converges to: bench/README.md.
+//
+//   trade [--quick] [--out DIR] [--scenes a,b] [--methods a,b] [--stiffness K] ...
+//
+// Writes DIR/trade.csv (one row per run), DIR/trade_scenes.csv (the scenes and
+// their reference steps), DIR/trade_fastest.csv (the fastest method to each
+// strain target) and DIR/trade_scaling.csv (time per iteration against size).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Core>
+
+#include "common/cli.h"
+#include "common/csv.h"
+#include "common/health.h"
+#include "common/metrics.h"
+#include "common/output.h"
+#include "common/scene.h"
+#include "common/sparse.h"
+#include "common/timer.h"
+#include "labs/lab06_projective_dynamics/simulation.h"
+#include "methods.h"
+
+namespace {
+
+using cl::bench::Family;
+
+struct Options {
+  bool quick = false;
+  std::string out = "out/bench";
+  std::vector<std::string> scenes;
+  std::vector<std::string> methods;
+  double stiffness = 1e6;
+  int repeats = 0;        // 0: 5 (quick 3)
+  int horizon = 0;        // 0: 20 (quick 10)
+  int warmup = 0;         // 0: 10 (quick 5)
+  double step_cap = 0.0;  // 0: 0.3 s (quick 0.05 s)
+  int threads = 1;        // OpenMP threads (Jacobi's sweep)
+};
+
+// The methods the trade compares (lab 05's limiter solves a different
+// problem again, explicit springs held in a band: only the extremes run it).
+const std::vector<std::string> kTradeMethods{"gs-pbd", "jacobi-pbd", "hpbd", "xpbd", "pd",
+                                             "newton", "kkt",        "schur", "schur-kg"};
+const std::vector<std::string> kAllScenes{"rope-100", "curtain-16", "curtain-32", "curtain-64", "curtain-128"};
+const std::vector<std::string> kQuickScenes{"rope-100", "curtain-16", "curtain-32"};
+
+// The shared scenes, with every spring of stiffness k (N/m). The gravity has a
+// breeze along z (as lab 06's curtains) so that every spring is in tension
+// and the implicit step has one clear minimum.
+cl::Scene make_scene(const std::string& name, double stiffness) {
+  const std::string k = cl::format_double(stiffness);
+  const std::string common = R"("gravity": [0, -9.81, 3], "dt": 0.0166666666666666667, )";
+  std::string text;
+  if (name == "rope-100") {
+    text = R"({"name": "rope-100", )" + common +
+           R"("chain": {"links": 100, "length": 0.01, "mass": 0.01, "direction": [1, 0, 0], "pin": "first", )"
+           R"("stiffness": )" + k + "}}";
+  } else if (name.rfind("curtain-", 0) == 0) {
+    const std::string n = name.substr(8);
+    if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos || n.size() > 4) {
+      throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100 or curtain-N, N >= 3)");
+    }
+    text = R"({"name": ")" + name + "\", " + common + R"("cloth": {"nx": )" + n + R"(, "ny": )" + n +
+           R"(, "width": 1, "height": 1, "mass": 1, "pin": ["top"], "springs": ["structural", "shear"], )"
+           R"("triangles": false, "stiffness": )" + k + "}}";
+  } else {
+    throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100 or curtain-N, N >= 3)");
+  }
+  return cl::parse_scene(text, "bench scene " + name);
+}
+
+std::vector<int> iteration_counts(const cl::bench::MethodInfo& method, bool quick) {
+  if (!method.iterative) return {1};
+  if (method.name == "newton") return quick ? std::vector<int>{1, 2, 3, 5, 10} : std::vector<int>{1, 2, 3, 4, 5, 7, 10, 15, 20};
+  return quick ? std::vector<int>{1, 3, 10, 30, 100}
+               : std::vector<int>{1, 2, 5, 10, 20, 50, 100, 200, 500, 1000};
+}
+
+double total_energy(const cl::Particles& particles, const cl::Scene& scene, bool elastic) {
+  double energy = cl::kinetic_energy(particles) + cl::potential_energy(particles, scene.gravity);
+  if (elastic) energy += cl::bench::elastic_energy(particles.x, scene.springs);
+  return energy;
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+// RMS over the particles of ‖a_p − b_p‖ (m).
+double rms_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
+  return a.cols() == 0 ? 0.0 : std::sqrt((a - b).colwise().squaredNorm().mean());
+}
+
+struct Run {
+  std::string scene, method;
+  int iterations = 0, iterations_done = 0, repeats = 0, horizon_steps = 0;
+  double step_seconds = 0, setup_seconds = 0;
+  double max_strain = 0, rms_strain = 0, distance = 0, distance_max = 0, relative_distance = 0;
+  double energy_drift = 0, energy_drift_rel = 0;
+  std::string problem;  // the step or the horizon went wrong (the run's numbers are then partial)
+  bool on_front = false;
+};
+
+struct SceneInfo {
+  std::string name;
+  long long particles = 0, springs = 0;
+  double reference_seconds = 0, reference_strain = 0, displacement = 0, energy_scale = 0;
+  int reference_iterations = 0;
+  double reference_gradient = 0.0;
+};
+
+// One progress line, rewritten in place on a terminal.
+class Progress {
+ public:
+  Progress() : tty_(isatty(fileno(stderr)) != 0) {}
+  void show(const std::string& text) {
+    if (!tty_) return;
+    std::fprintf(stderr, "\r\033[K%s", text.c_str());
+    std::fflush(stderr);
+  }
+  void clear() {
+    if (tty_) std::fprintf(stderr, "\r\033[K");
+  }
+
+ private:
+  bool tty_;
+};
+
+// The CSV cell text (common/csv.h does not quote): no commas.
+std::string csv_text(std::string text) {
+  for (char& c : text) {
+    if (c == ',') c = ';';
+  }
+  return text;
+}
+
+std::string format(const char* pattern, double value) {
+  char text[64];
+  std::snprintf(text, sizeof text, pattern, value);
+  return text;
+}
+
+std::string time_text(double seconds) {
+  if (seconds < 1e-3) return format("%.3g us", seconds * 1e6);
+  if (seconds < 1.0) return format("%.3g ms", seconds * 1e3);
+  return format("%.3g s", seconds);
+}
+
+// The reference step from `start`: the minimiser of lab 06's objective g
+// (implicit Euler), found by 500 PD iterations and then Newton's method with
+// lab 06's gradient and (clamped) Hessian and a backtracking line search,
+// until the gradient stops shrinking. (Newton from the prediction, as lab 06's
+// step starts, needs hundreds of damped iterations on the stiff 128² curtain.)
+struct Reference {
+  cl::Particles after;
+  int newton_iterations = 0;
+  double gradient_norm = 0.0;  // ‖∇g‖∞ at the result, N
+  double seconds = 0.0;
+};
+
+Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
+  const cl::Timer timer;
+  Reference ref;
+  const cl::lab06::Problem problem = cl::lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
+  const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
+  ref.after = start;
+  std::unique_ptr<cl::bench::Stepper> pd = cl::bench::make_stepper("pd", scene, 500);
+  const cl::bench::StepOutcome outcome = pd->step(ref.after);
+  if (!outcome.problem.empty()) throw std::runtime_error(scene.name + ": reference: " + outcome.problem);
+  Eigen::Matrix3Xd x = ref.after.x;
+  cl::SpdFactorization factor;
+  double g = cl::lab06::objective(problem, x, y);
+  for (int k = 1; k <= 50; ++k) {
+    const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
+    if (!factor.refactor(cl::lab06::newton_hessian(problem, x))) break;
+    const Eigen::VectorXd step = factor.solve(-gradient);
+    const double slope = gradient.dot(step);
+    double alpha = 1.0;
+    Eigen::Matrix3Xd trial = x;
+    bool accepted = false;
+    for (int halving = 0; halving < 40 && !accepted; ++halving, alpha *= 0.5) {
+      trial = x;
+      for (int u = 0; u < problem.map.unknowns(); ++u) {
+        trial.col(problem.map.particle_of[static_cast<std::size_t>(u)]) += alpha * step.segment<3>(3 * u);
+      }
+      accepted = cl::lab06::objective(problem, trial, y) <= g + 1e-4 * alpha * slope;
+    }
+    // At round-off the objective cannot tell a better x from a worse one:
+    // take the full step while it keeps shrinking, as lab 06's Newton does.
+    const double length = step.cwiseAbs().maxCoeff();
+    if (!accepted) {
+      if (length > 1e-9 * std::max(1.0, x.cwiseAbs().maxCoeff())) break;
+      for (int u = 0; u < problem.map.unknowns(); ++u) {
+        x.col(problem.map.particle_of[static_cast<std::size_t>(u)]) += step.segment<3>(3 * u);
+      }
+    } else {
+      x = trial;
+    }
+    g = cl::lab06::objective(problem, x, y);
+    ref.newton_iterations = k;
+    if (length <= 64.0 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff()) break;
+  }
+  ref.gradient_norm = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    ref.after.v.col(p) = start.inv_mass[p] > 0.0 ? Eigen::Vector3d((x.col(p) - start.x.col(p)) / scene.dt)
+                                                 : Eigen::Vector3d::Zero();
+  }
+  ref.after.x = x;
+  ref.seconds = timer.seconds();
+  return ref;
+}
+
+// Marks the runs of one scene on the Pareto front of (step time, max strain
+// error): no other run is at least as fast and at least as accurate, and
+// strictly better in one. Runs with a problem are left out.
+void mark_front(std::vector<Run>& runs, std::size_t begin) {
+  for (std::size_t a = begin; a < runs.size(); ++a) {
+    if (!runs[a].problem.empty()) continue;
+    bool dominated = false;
+    for (std::size_t b = begin; b < runs.size() && !dominated; ++b) {
+      if (a == b || !runs[b].problem.empty()) continue;
+      dominated = runs[b].step_seconds <= runs[a].step_seconds && runs[b].max_strain <= runs[a].max_strain &&
+                  (runs[b].step_seconds < runs[a].step_seconds || runs[b].max_strain < runs[a].max_strain);
+    }
+    runs[a].on_front = !dominated;
+  }
+}
+
+int run(const Options& options) {
+  const std::vector<std::string> scenes = options.scenes.empty() ? (options.quick ? kQuickScenes : kAllScenes)
+                                                                 : options.scenes;
+  std::vector<std::string> methods = options.methods.empty() ? kTradeMethods : options.methods;
+  for (const std::string& method : methods) {
+    try {
+      cl::bench::method_info(method);
+    } catch (const std::invalid_argument& error) {
+      throw cl::InputError(std::string("--methods: ") + error.what());
+    }
+  }
+  const int repeats = options.repeats > 0 ? options.repeats : (options.quick ? 3 : 5);
+  const int horizon = options.horizon > 0 ? options.horizon : (options.quick ? 10 : 20);
+  const int warmup = options.warmup > 0 ? options.warmup : (options.quick ? 5 : 10);
+  const double cap = options.step_cap > 0.0 ? options.step_cap : (options.quick ? 0.05 : 0.3);
+  for (const std::string& name : scenes) make_scene(name, options.stiffness);  // bad names fail before any work
+  cl::ensure_directory(options.out);
+#ifdef _OPENMP
+  omp_set_num_threads(options.threads);
+#endif
+
+  std::printf("trade: %zu scenes x %zu methods, k = %g N/m, %d repeats, horizon %d steps, warm-up %d steps, "
+              "K grows while a step takes < %s, %d thread(s)\n",
+              scenes.size(), methods.size(), options.stiffness, repeats, horizon, warmup, time_text(cap).c_str(), options.threads);
+  std::fflush(stdout);
+  const cl::Timer total;
+  Progress progress;
+  std::vector<Run> runs;
+  std::vector<SceneInfo> infos;
+
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const cl::Scene scene = make_scene(scenes[s], options.stiffness);
+    SceneInfo info;
+    info.name = scene.name;
+    info.particles = scene.particles.size();
+    info.springs = static_cast<long long>(scene.springs.size());
+    const std::string where = "[" + std::to_string(s + 1) + "/" + std::to_string(scenes.size()) + " " + scene.name + "]";
+
+    // The shared start: a few implicit-Euler steps from the scene's rest state
+    // (PD, 100 iterations: cheap once factored, and close enough to converged
+    // for a start), so that the springs carry load and the cloth moves. The
+    // reference step from there is Newton's, to round-off.
+    progress.show(where + " warm-up");
+    const cl::Timer warmup_timer;
+    std::unique_ptr<cl::bench::Stepper> warm = cl::bench::make_stepper("pd", scene, 100);
+    cl::Particles start = scene.particles;
+    for (int w = 0; w < warmup; ++w) {
+      const cl::bench::StepOutcome outcome = warm->step(start);
+      if (!outcome.problem.empty()) throw std::runtime_error(scene.name + ": warm-up: " + outcome.problem);
+    }
+    const Reference reference = reference_step(scene, start);
+    const cl::Particles& converged = reference.after;
+    info.reference_seconds = reference.seconds;
+    info.reference_iterations = reference.newton_iterations;
+    info.reference_gradient = reference.gradient_norm;
+    info.reference_strain = cl::strain_stats(converged.x, scene.springs).max;
+    info.displacement = rms_distance(converged.x, start.x);
+    info.energy_scale = cl::energy_scale(start, scene.gravity, scene.dt);
+    infos.push_back(info);
+    progress.clear();
+    std::printf("%-12s warm-up and reference step (pd 500 + newton %d iterations to |grad g| %.1e N, %s): %.1f s\n",
+                scene.name.c_str(), info.reference_iterations, info.reference_gradient,
+                time_text(info.reference_seconds).c_str(), warmup_timer.seconds());
+    std::fflush(stdout);
+
+    const std::size_t first_run = runs.size();
+    for (const std::string& method_name : methods) {
+      const cl::bench::MethodInfo& method = cl::bench::method_info(method_name);
+      if (method.grid_only && scene.grid_nx == 0) continue;
+      const bool elastic = method.family != Family::kHard;
+      const cl::Timer method_timer;
+      int done_runs = 0;
+      for (const int k : iteration_counts(method, options.quick)) {
+        progress.show(where + " " + method.name + " K=" + std::to_string(k) + "  (" +
+                      format("%.0f s", total.seconds()) + ")");
+        Run r;
+        r.scene = scene.name;
+        r.method = method.name;
+        r.iterations = k;
+        const cl::Timer setup;
+        std::unique_ptr<cl::bench::Stepper> stepper = cl::bench::make_stepper(method.name, scene, k);
+        r.setup_seconds = setup.seconds();
+
+        // Repeats of the one step from the shared start, with one solver (its
+        // factor and symbolic analysis reused, as in a run). The first repeat's
+        // result is the one measured.
+        std::vector<double> times;
+        cl::Particles one;
+        double timed = 0.0;
+        for (int rep = 0; rep < 200 && (rep < repeats || timed < 0.02); ++rep) {  // short steps: more repeats
+          cl::Particles state = start;
+          const cl::Timer step_timer;
+          const cl::bench::StepOutcome outcome = stepper->step(state);
+          times.push_back(step_timer.seconds());
+          timed += times.back();
+          if (rep == 0) {
+            one = state;
+            r.iterations_done = outcome.iterations;
+            r.problem = outcome.problem;
+          }
+          if (!outcome.problem.empty() || times.front() > 2.0 * cap) break;  // slow: one timing will do
+        }
+        r.repeats = static_cast<int>(times.size());
+        r.step_seconds = median(times);
+        const cl::StrainStats strain = cl::strain_stats(one.x, scene.springs);
+        r.max_strain = strain.max;
+        r.rms_strain = strain.rms;
+        r.distance = rms_distance(one.x, converged.x);
+        r.distance_max = (one.x - converged.x).colwise().norm().maxCoeff();
+        r.relative_distance = info.displacement > 0.0 ? r.distance / info.displacement : 0.0;
+
+        // The horizon: `horizon` steps from the shared start with one solver.
+        if (r.problem.empty()) {
+          std::unique_ptr<cl::bench::Stepper> runner = cl::bench::make_stepper(method.name, scene, k);
+          cl::Particles state = start;
+          const double e0 = total_energy(state, scene, elastic);
+          for (int step = 1; step <= horizon; ++step) {
+            const cl::bench::StepOutcome outcome = runner->step(state);
+            std::string trouble = outcome.problem;
+            if (trouble.empty()) trouble = cl::health_problem(state, cl::strain_stats(state.x, scene.springs));
+            if (!trouble.empty()) {
+              r.problem = "horizon step " + std::to_string(step) + ": " + trouble;
+              break;
+            }
+            r.horizon_steps = step;
+          }
+          r.energy_drift = total_energy(state, scene, elastic) - e0;
+          r.energy_drift_rel = info.energy_scale > 0.0 ? r.energy_drift / info.energy_scale : 0.0;
+        }
+        runs.push_back(r);
+        ++done_runs;
+        // More iterations would take too long, or change nothing (Newton stopped early).
+        if (r.step_seconds > cap || (method.iterative && r.iterations_done < k) || !r.problem.empty()) break;
+      }
+      progress.clear();
+      const Run& last = runs.back();
+      std::printf("%-12s %-10s %2d runs, K up to %4d: max strain %.2e, %s per step  (%.1f s)\n", scene.name.c_str(),
+                  method.name.c_str(), done_runs, last.iterations, last.max_strain, time_text(last.step_seconds).c_str(),
+                  method_timer.seconds());
+      std::fflush(stdout);
+    }
+    mark_front(runs, first_run);
+  }
+  progress.clear();
+
+  // ---------------------------------------------------------------- output
+  cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "iterations", "iterations_done",
+                      "step_seconds", "seconds_per_iteration", "repeats", "setup_seconds", "max_strain", "rms_strain",
+                      "distance_rms", "distance_max", "relative_distance", "horizon_steps", "energy_drift",
+                      "energy_drift_rel", "on_front", "problem"});
+  auto info_of = [&](const std::string& name) -> const SceneInfo& {
+    return *std::find_if(infos.begin(), infos.end(), [&](const SceneInfo& i) { return i.name == name; });
+  };
+  for (const Run& r : runs) {
+    const cl::bench::MethodInfo& method = cl::bench::method_info(r.method);
+    const SceneInfo& info = info_of(r.scene);
+    table.add_row({r.scene, info.particles, info.springs, r.method, std::string(cl::bench::family_name(method.family)),
+                   method.lab, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
+                   r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
+                   r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance,
+                   static_cast<long long>(r.horizon_steps), r.energy_drift, r.energy_drift_rel,
+                   static_cast<long long>(r.on_front ? 1 : 0), csv_text(r.problem)});
+  }
+  table.write(cl::join_path(options.out, "trade.csv"));
+
+  cl::CsvTable scene_table({"scene", "particles", "springs", "stiffness", "dt", "warmup_steps", "reference_newton_iterations", "reference_gradient_norm",
+                            "reference_seconds", "reference_max_strain", "step_displacement_rms", "energy_scale"});
+  for (const SceneInfo& info : infos) {
+    scene_table.add_row({info.name, info.particles, info.springs, options.stiffness, 1.0 / 60.0,
+                         static_cast<long long>(warmup), static_cast<long long>(info.reference_iterations), info.reference_gradient,
+                         info.reference_seconds, info.reference_strain, info.displacement, info.energy_scale});
+  }
+  scene_table.write(cl::join_path(options.out, "trade_scenes.csv"));
+
+  // The fastest run to each target, per scene: of the max strain error (the
+  // issue's table) and of the distance to the reference step relative to the
+  // step's displacement (which a method can only reach by solving the step).
+  const std::vector<double> targets{1e-2, 1e-3};
+  const char* const measures[2] = {"max_strain", "relative_distance"};
+  auto value_of = [](const Run& r, int measure) { return measure == 0 ? r.max_strain : r.relative_distance; };
+  cl::CsvTable fastest({"scene", "measure", "target", "method", "iterations", "step_seconds", "value"});
+  // best[measure][scene][target]
+  std::vector<std::vector<std::vector<const Run*>>> best(
+      2, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(targets.size(), nullptr)));
+  for (int m = 0; m < 2; ++m) {
+    for (std::size_t s = 0; s < infos.size(); ++s) {
+      for (std::size_t t = 0; t < targets.size(); ++t) {
+        const Run*& b = best[static_cast<std::size_t>(m)][s][t];
+        for (const Run& r : runs) {
+          if (r.scene != infos[s].name || !r.problem.empty() || !(value_of(r, m) <= targets[t])) continue;
+          if (!b || r.step_seconds < b->step_seconds) b = &r;
+        }
+        if (b) {
+          fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], b->method,
+                           static_cast<long long>(b->iterations), b->step_seconds, value_of(*b, m)});
+        } else {
+          fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], std::string("none"), 0LL, 0.0, 0.0});
+        }
+      }
+    }
+  }
+  fastest.write(cl::join_path(options.out, "trade_fastest.csv"));
+
+  // Time per iteration against size, on the curtains: per method the run with
+  // the iteration count nearest 10 (a direct solve: its one solve).
+  cl::CsvTable scaling({"method", "scene", "particles", "springs", "iterations_done", "seconds_per_iteration"});
+  std::vector<std::pair<std::string, std::pair<double, int>>> exponents;
+  for (const std::string& method_name : methods) {
+    std::vector<double> log_n, log_t;
+    for (const SceneInfo& info : infos) {
+      if (info.name.rfind("curtain-", 0) != 0) continue;
+      const Run* pick = nullptr;
+      for (const Run& r : runs) {
+        if (r.scene != info.name || r.method != method_name || r.iterations_done < 1) continue;
+        if (!pick || std::abs(std::log(r.iterations / 10.0)) < std::abs(std::log(pick->iterations / 10.0))) pick = &r;
+      }
+      if (!pick) continue;
+      const double per = pick->step_seconds / pick->iterations_done;
+      scaling.add_row({method_name, info.name, info.particles, info.springs,
+                       static_cast<long long>(pick->iterations_done), per});
+      log_n.push_back(std::log(static_cast<double>(info.particles)));
+      log_t.push_back(std::log(per));
+    }
+    if (log_n.size() >= 2) {
+      const Eigen::Map<Eigen::VectorXd> xs(log_n.data(), static_cast<Eigen::Index>(log_n.size()));
+      const Eigen::Map<Eigen::VectorXd> ys(log_t.data(), static_cast<Eigen::Index>(log_t.size()));
+      const Eigen::VectorXd dx = xs.array() - xs.mean();
+      const Eigen::VectorXd dy = ys.array() - ys.mean();
+      exponents.push_back({method_name, {dx.dot(dy) / dx.squaredNorm(), static_cast<int>(log_n.size())}});
+    }
+  }
+  scaling.write(cl::join_path(options.out, "trade_scaling.csv"));
+
+  // ---------------------------------------------------------------- summary
+  std::printf("\ntrade: %zu runs on %zu scenes in %.0f s; CSV in %s\n", runs.size(), infos.size(), total.seconds(),
+              options.out.c_str());
+  const char* const titles[2] = {"max strain error", "distance to the reference step / step displacement"};
+  for (int m = 0; m < 2; ++m) {
+    std::printf("fastest method to %s <= 1e-2 and <= 1e-3 (median wall time per step):\n", titles[m]);
+    std::printf("  %-12s %-30s %-30s\n", "scene", "<= 1e-2", "<= 1e-3");
+    for (std::size_t s = 0; s < infos.size(); ++s) {
+      std::string cells[2];
+      for (std::size_t t = 0; t < targets.size(); ++t) {
+        const Run* b = best[static_cast<std::size_t>(m)][s][t];
+        cells[t] = b ? b->method +
+                           (cl::bench::method_info(b->method).iterative ? " K=" + std::to_string(b->iterations) : "") +
+                           " " + time_text(b->step_seconds)
+                     : "none reached";
+      }
+      std::printf("  %-12s %-30s %-30s\n", infos[s].name.c_str(), cells[0].c_str(), cells[1].c_str());
+    }
+  }
+  if (!exponents.empty()) {
+    std::printf("time per iteration ~ particles^p on the curtains:");
+    for (const auto& [name, fit] : exponents) std::printf(" %s %.2f", name.c_str(), fit.first);
+    std::printf("\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"The speed/accuracy trade: every method on shared scenes (bench/README.md)."};
+  app.name("trade");
+  Options options;
+  app.add_flag("--quick", options.quick, "CI size: rope-100, curtain-16 and -32, fewer iterations, repeats and steps");
+  app.add_option("--out", options.out, "folder for the CSV files")->capture_default_str();
+  app.add_option("--scenes", options.scenes, "rope-100, curtain-N (default: rope-100 and curtains 16 to 128)")
+      ->delimiter(',');
+  app.add_option("--methods", options.methods, "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg")
+      ->delimiter(',');
+  app.add_option("--stiffness", options.stiffness, "every spring's stiffness, N/m")
+      ->check(cl::finite_number(false))
+      ->capture_default_str();
+  app.add_option("--repeats", options.repeats, "timed repeats of each step (default 5, quick 3)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--horizon", options.horizon, "steps of the energy-drift run (default 20, quick 10)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--warmup", options.warmup, "PD steps (100 iterations) before the shared start (default 10, quick 5)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--step-cap", options.step_cap, "stop raising K once a step takes this long, s (default 0.3, quick 0.05)")
+      ->check(cl::finite_number(false));
+  app.add_option("--threads", options.threads, "OpenMP threads for Jacobi's sweep (1: comparable timings on a shared machine)")
+      ->check(CLI::Range(1, 256))
+      ->capture_default_str();
+  return cl::run_main(app, argc, argv, [&] { return run(options); });
+}

@@ -1,0 +1,87 @@
+#!/usr/bin/env python3
+"""The speed/accuracy trade (issue 12): per scene, error against wall time per
+step for every method and iteration count, the Pareto front highlighted. Top
+row: max strain error; bottom row: distance to the converged reference step,
+relative to the step's displacement. Reads OUTDIR/bench/trade.csv, writes
+OUTDIR/bench/pareto.png."""
+import csv
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+COMMAND = "./course bench  (or: build/bin/trade --out out/bench)"
+FAMILY_MARKER = {"hard": "s", "implicit-euler": "o", "linearized": "D", "limited": "v"}
+
+
+def front(points):
+    """The points no other point beats in both coordinates (time, error), fastest first."""
+    kept, best = [], float("inf")
+    for t, e in sorted(points):
+        if e < best:
+            kept.append((t, e))
+            best = e
+    return kept
+
+
+def main(out_dir):
+    bench = Path(out_dir) / "bench"
+    table = bench / "trade.csv"
+    if not table.exists():
+        print(f"bench_pareto: no {table}; make it with {COMMAND}")
+        return 4
+    with open(table, newline="") as handle:
+        rows = [r for r in csv.DictReader(handle) if not r["problem"]]
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    methods = list(dict.fromkeys(r["method"] for r in rows))
+    colors = {m: plt.cm.tab10(i % 10) for i, m in enumerate(methods)}
+    measures = (("max_strain", "max strain error"),
+                ("relative_distance", "distance to reference step\n/ step displacement"))
+    figure, axes = plt.subplots(2, len(scenes), figsize=(3.9 * len(scenes), 7.6), squeeze=False)
+    for column, scene in enumerate(scenes):
+        mine = [r for r in rows if r["scene"] == scene]
+        for row, (key, label) in enumerate(measures):
+            ax = axes[row][column]
+            for method in methods:
+                runs = sorted((r for r in mine if r["method"] == method), key=lambda r: int(r["iterations"]))
+                if not runs:
+                    continue
+                t = [float(r["step_seconds"]) for r in runs]
+                e = [max(float(r[key]), 1e-16) for r in runs]
+                ax.loglog(t, e, "-", marker=FAMILY_MARKER.get(runs[0]["family"], "o"), markersize=4,
+                          color=colors[method], alpha=0.85, label=f"{method} ({runs[0]['family']})")
+            best = front([(float(r["step_seconds"]), max(float(r[key]), 1e-16)) for r in mine])
+            ax.step([p[0] for p in best], [p[1] for p in best], where="post", color="black", linewidth=1.2,
+                    zorder=0, label="Pareto front")
+            ax.scatter([p[0] for p in best], [p[1] for p in best], s=70, facecolors="none", edgecolors="black",
+                       linewidths=1.2, zorder=5)
+            for target in (1e-2, 1e-3):
+                ax.axhline(target, color="gray", linestyle=":", linewidth=0.8)
+            ax.set_xlabel("wall time per step (s)")
+            if column == 0:
+                ax.set_ylabel(label)
+            if row == 0:
+                ax.set_title(scene)
+            ax.grid(True, which="major", alpha=0.3)
+    handles, labels = axes[0][-1].get_legend_handles_labels()
+    for ax in axes.flat:
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in labels:
+                handles.append(h)
+                labels.append(lab)
+    figure.legend(handles, labels, loc="lower center", ncol=min(len(labels), 5), fontsize=8)
+    figure.suptitle("Error against time per step: one step from a shared state, K growing along each line "
+                    "(circles: the Pareto front)", fontsize=11)
+    figure.tight_layout(rect=(0, 0.09, 1, 0.96))
+    target = bench / "pareto.png"
+    figure.savefig(target, dpi=100)
+    plt.close(figure)
+    print(f"wrote {target}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
