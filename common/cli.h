@@ -1,5 +1,5 @@
 #pragma once
-// The command line shared by every lab executable (COURSE.md §3) and the
+// The command line shared by every lab executable (docs/DESIGN.md §3) and the
 // wrapper that turns every failure into one line on stderr and an exit code:
 //   0 done, 2 bad input or usage, 3 a student function not implemented yet.
 #include <functional>

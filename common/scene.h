@@ -1,5 +1,5 @@
 #pragma once
-// Scenes: the JSON format of COURSE.md §3, with strict validation.
+// Scenes: the JSON format of docs/DESIGN.md §3, with strict validation.
 #include <optional>
 #include <stdexcept>
 #include <string>

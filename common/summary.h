@@ -1,5 +1,5 @@
 #pragma once
-// The run summary of COURSE.md §3, written by --summary.
+// The run summary of docs/DESIGN.md §3, written by --summary.
 #include <optional>
 #include <string>
 

@@ -21,7 +21,8 @@ def read_rows(path):
 def main(out_dir):
     source = Path(out_dir) / LAB / "mass_ratio_sweep.csv"
     if not source.exists():
-        print(f"lab01_mass_ratio: no {source} (run the lab 01 demo first)")
+        print(f"lab01_mass_ratio: needs {source}; make it with: ./course run lab01_solution "
+              f"--scene equal-masses --sweep-mass-ratio --out {source.parent}")
         return 4
     rows = read_rows(source)
     ratio = [row["mass_ratio"] for row in rows]

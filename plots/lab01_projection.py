@@ -50,7 +50,8 @@ def main(out_dir):
     lab_dir = Path(out_dir) / LAB
     cases = sorted(p for p in lab_dir.glob("*") if (p / "positions.csv").exists() and (p / "springs.csv").exists())
     if not cases:
-        print(f"lab01_projection: no {lab_dir}/<scene>/positions.csv (run the lab 01 demo first)")
+        print(f"lab01_projection: needs {lab_dir}/SCENE/positions.csv and springs.csv; make them with: "
+              f"./course run lab01_solution --scene triangle --out {lab_dir}/triangle (every scene: ./course demo)")
         return 4
     columns = min(3, len(cases))
     rows = math.ceil(len(cases) / columns)

@@ -112,7 +112,9 @@ def main(argv):
     lab_dir = Path(argv[1]) / LAB
     runs = load_runs(lab_dir)
     if not runs:
-        print(f"lab02_orders: no order runs in {lab_dir} (run ./course demo)", file=sys.stderr)
+        print(f"lab02_orders: needs {lab_dir}/chain-forward.json and chain-forward/convergence.csv (and the "
+              f"other order runs of labs/lab02_gauss_seidel/demo.txt); make them with: ./course demo "
+              f"--out {argv[1]}", file=sys.stderr)
         return 4
     convergence_figure(runs, "sweep", "sweep", 1.0, lab_dir / "lab02_orders.png")
     convergence_figure(runs, "total_seconds", "wall time of the sweeps (ms)", 1e3, lab_dir / "lab02_error_vs_time.png")

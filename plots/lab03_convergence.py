@@ -136,7 +136,9 @@ def main(argv):
         return 2
     lab_dir = Path(argv[1]) / LAB
     if not any(load(lab_dir, prefix) for prefix, _ in SCENES):
-        print(f"lab03_convergence: no chain-*/cloth-* runs in {lab_dir} (run ./course demo)", file=sys.stderr)
+        print(f"lab03_convergence: needs {lab_dir}/chain-gs.json and chain-gs/convergence.csv (and the other "
+              f"chain-*/cloth-* runs of labs/lab03_jacobi/demo.txt); make them with: ./course demo --out {argv[1]}",
+              file=sys.stderr)
         return 4
     comparison_figure(lab_dir, "sweep", "sweep", 1.0, lab_dir / "lab03_gs_vs_jacobi.png")
     comparison_figure(lab_dir, "total_seconds", "wall time of the sweeps (ms)", 1e3,

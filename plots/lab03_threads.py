@@ -34,7 +34,9 @@ def main(argv):
             if seconds:
                 runs.append((summary, seconds))
     if not runs:
-        print(f"lab03_threads: no threads-N runs in {lab_dir} (run ./course demo)", file=sys.stderr)
+        print(f"lab03_threads: needs {lab_dir}/threads-1.json and threads-1/convergence.csv (and threads-2); "
+              f"make them with: ./course run lab03_solution --scene cloth-128 --threads 1 --iterations 200 "
+              f"--out {lab_dir}/threads-1 --summary {lab_dir}/threads-1.json (then --threads 2)", file=sys.stderr)
         return 4
     runs.sort(key=lambda run: run[0]["threads"])
 

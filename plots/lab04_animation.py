@@ -51,8 +51,9 @@ def main(argv):
     out_dir = argv[0] if argv else "out"
     runs = mesh.frame_dirs(out_dir)
     if not runs:
-        print(f"lab04_animation: no OBJ frames under {Path(out_dir) / mesh.LAB}/*/frames "
-              "(run lab04_pbd with --frames N --out DIR first)")
+        lab_dir = Path(out_dir) / mesh.LAB
+        print(f"lab04_animation: needs OBJ frames in {lab_dir}/RUN/frames/; make them with: ./course run "
+              f"lab04_solution --scene curtain-32 --iterations 16 --steps 90 --frames 2 --out {lab_dir}/curtain-32")
         return 4
     for run_dir in runs:
         animate(run_dir)

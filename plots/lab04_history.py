@@ -70,7 +70,9 @@ def draw(source, summary):
 def main(out_dir):
     sources = sorted((Path(out_dir) / LAB).glob("*/per_frame.csv"))
     if not sources:
-        print(f"lab04_history: no {Path(out_dir) / LAB}/*/per_frame.csv (run the lab 04 demo first)")
+        lab_dir = Path(out_dir) / LAB
+        print(f"lab04_history: needs {lab_dir}/RUN/per_frame.csv; make it with: ./course run lab04_solution "
+              f"--scene curtain-32 --iterations 16 --steps 90 --out {lab_dir}/curtain-32 --summary {lab_dir}/curtain-32.json")
         return 4
     for source in sources:
         draw(source, source.parent.with_suffix(".json"))

@@ -52,8 +52,9 @@ def main(argv):
     wanted = [int(n) for n in args.frames.split(",") if n.strip()]
     runs = mesh.frame_dirs(args.out_dir)
     if not runs:
-        print(f"lab04_snapshots: no OBJ frames under {Path(args.out_dir) / mesh.LAB}/*/frames "
-              "(run lab04_pbd with --frames N --out DIR first)")
+        lab_dir = Path(args.out_dir) / mesh.LAB
+        print(f"lab04_snapshots: needs OBJ frames in {lab_dir}/RUN/frames/; make them with: ./course run "
+              f"lab04_solution --scene curtain-32 --iterations 16 --steps 90 --frames 2 --out {lab_dir}/curtain-32")
         return 4
     for run_dir in runs:
         snapshot(run_dir, wanted)

@@ -67,7 +67,9 @@ def draw(axes, runs, column, label, reference=False):
 def main(out_dir):
     source = Path(out_dir) / LAB / "strain_vs_iterations.csv"
     if not source.exists():
-        print(f"lab04_strain_vs_iterations: no {source} (run the lab 04 demo first)")
+        print(f"lab04_strain_vs_iterations: needs {source}; make it with: ./course run lab04_solution "
+              f"--sweep-iterations 1,2,4,8,16,32,64,128 --sweep-scenes curtain-8,curtain-16,curtain-32,curtain-64 "
+              f"--steps 3600 --out {source.parent}")
         return 4
     runs = read_runs(source)
     first = next(iter(runs.values()))[0]

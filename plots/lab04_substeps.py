@@ -23,7 +23,8 @@ def number(text):
 def main(out_dir):
     source = Path(out_dir) / LAB / "substeps.csv"
     if not source.exists():
-        print(f"lab04_substeps: no {source} (run the lab 04 demo first)")
+        print(f"lab04_substeps: needs {source}; make it with: ./course run lab04_solution --sweep-substeps "
+              f"1,2,4,8,16,32,64 --cost 64 --sweep-scenes curtain-32,rope-50 --steps 3600 --out {source.parent}")
         return 4
     runs = defaultdict(list)
     with open(source, newline="") as handle:

@@ -3,7 +3,9 @@
 A graded case is tagged [labNN][pts=N]. Each case runs alone, so a crash or a
 hang costs only that case. Results can be written as Gradescope JSON.
 """
+import fnmatch
 import json
+import os
 import re
 import signal
 import subprocess
@@ -17,7 +19,16 @@ LIST_TIMEOUT = 60  # seconds for a listing
 # Characters that Catch2's test-spec parser reads as syntax, not as part of a name.
 UNSELECTABLE = re.compile(r'[,\[\]*\\"]|^~|^exclude:')
 PTS_TAG = re.compile(r"\[pts=([^\]]*)\]", re.IGNORECASE)
+# Cases tagged [hidden] (in tests/*/hidden_*.cpp) run only in the Gradescope
+# bundle (tools/autograder.py) and in the honesty checks; local grading skips them.
+HIDDEN_TAG = "[hidden]"
 FAILURE_TAGS = ("Expression", "Exception", "FatalErrorCondition", "Failure")
+# OpenMP threads that wait sleep instead of spinning: on a shared or busy
+# machine a spinning barrier costs a tiny parallel sweep milliseconds, and
+# 10,000 sweeps then hit the time limit. Results are the same bits.
+CASE_ENV = {**os.environ, "OMP_WAIT_POLICY": os.environ.get("OMP_WAIT_POLICY", "passive")}
+TERMINAL_CAP = 300  # characters of one failure's reason, and of its context, on the terminal
+JSON_CAP = 4000  # characters of one case's output in results.json
 
 
 @dataclass
@@ -29,6 +40,7 @@ class CaseResult:
     passed: bool
     reason: str = ""  # one line
     details: list = field(default_factory=list)  # CAPTUREd values etc.
+    signal: int = 0  # the signal that killed the case, 0 if none
 
     @property
     def score(self):
@@ -79,8 +91,35 @@ def fmt_points(value):
     return f"{value:g}"
 
 
-def grade_lab(lab, binary, root):
-    """Run every case of `binary` tagged with the lab's tag; return a LabResult."""
+def case_filter(pattern):
+    """A predicate on case names for `-t PATTERN`: a Catch2-style wildcard (`*`)
+    or else a case-insensitive substring; None selects everything."""
+    if not pattern:
+        return None
+    if "*" in pattern or "?" in pattern:
+        return lambda name: fnmatch.fnmatchcase(name.lower(), pattern.lower())
+    return lambda name: pattern.lower() in name.lower()
+
+
+def source_points(test_dir, tag):
+    """Total [pts=N] of the TEST_CASEs tagged `tag` in test_dir/*.cpp: the most a
+    lab can score, known even when its tests do not compile."""
+    total = 0.0
+    for source in sorted(Path(test_dir).glob("*.cpp")):
+        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', source.read_text()):
+            if tag.lower() in tags.lower() and HIDDEN_TAG not in tags.lower():
+                for spelling in PTS_TAG.findall(tags):
+                    try:
+                        total += float(spelling)
+                    except ValueError:
+                        pass
+    return int(total) if total.is_integer() else total
+
+
+def grade_lab(lab, binary, root, select=None, hidden=False):
+    """Run every case of `binary` tagged with the lab's tag (and accepted by
+    `select`, a predicate on names; the [hidden] ones only when `hidden`);
+    return a LabResult."""
     result = LabResult(lab)
     if not binary.is_file():
         result.errors.append(f"{relative(binary, root)} not found (is {lab} added in CMakeLists.txt?)")
@@ -89,11 +128,16 @@ def grade_lab(lab, binary, root):
     try:
         names = list_names(binary, tag)
         points = case_points(binary, tag, names, result.errors)
+        if not hidden:
+            skipped = set(list_names(binary, tag + HIDDEN_TAG))
+            names = [name for name in names if name not in skipped]
     except ListingError as error:
         result.errors.append(f"{relative(binary, root)}: {error}")
         return result
     if not names:
         result.errors.append(f"{relative(binary, root)} has no test case tagged {tag}")
+    if select is not None:
+        names = [name for name in names if select(name)]
     with tempfile.TemporaryDirectory(prefix="cl-grade-") as work:
         for name in names:
             unselectable = UNSELECTABLE.search(name)
@@ -156,13 +200,14 @@ def run_case(binary, name, points, work, root):
     report = work / "report.xml"
     report.unlink(missing_ok=True)
     try:
-        done = subprocess.run([str(binary), name, "-r", "xml", "-o", str(report)],
-                              cwd=work, capture_output=True, timeout=CASE_TIMEOUT, check=False)
+        done = subprocess.run([str(binary), name, "-r", "xml", "-o", str(report)], cwd=work, env=CASE_ENV,
+                              capture_output=True, timeout=CASE_TIMEOUT, check=False)
     except subprocess.TimeoutExpired:
         return CaseResult(name, points, False, f"timed out after {CASE_TIMEOUT} s")
     if done.returncode < 0:
         number = -done.returncode
-        return CaseResult(name, points, False, f"crashed (signal {number}, {signal_name(number)})")
+        return CaseResult(name, points, False, f"crashed (signal {number}, {signal_name(number)})",
+                          signal=number)
     test_case = read_test_case(report, name)
     if test_case is None:
         return CaseResult(name, points, False, f"exit code {done.returncode} with no result")
@@ -237,11 +282,24 @@ def relative(path, root):
         return str(path)
 
 
+def clip(text, limit, note="see build/grade/results.json"):
+    """`text` cut to about `limit` characters, saying how much was cut."""
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit]}... [{len(text) - limit} more characters; {note}]"
+
+
+def context_line(case):
+    """A failing case's CAPTUREd / INFO context on one line, or ""."""
+    return "with " + "; ".join(case.details) if case.details else ""
+
+
 def case_output(case):
     """The text a student sees for one case in Gradescope."""
     if case.passed:
         return "passed"
-    return "\n".join([case.reason, *(f"with {info}" for info in case.details)])
+    lines = [case.reason, *(f"with {info}" for info in case.details)]
+    return clip("\n".join(lines), JSON_CAP, "cut by the grader")
 
 
 def write_gradescope(path, labs):
@@ -260,3 +318,53 @@ def write_gradescope(path, labs):
                "tests": tests}
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(results, indent=2) + "\n")
+
+
+# ---------------------------------------------------------------- sanitizer reports
+
+SANITIZER_ERROR = re.compile(r"==\d+==ERROR: (\w+Sanitizer): (.*)")
+UBSAN_ERROR = re.compile(r"^(\S+?):(\d+):\d+: runtime error: (.*)$")
+ASSERTION = re.compile(r"(Assertion .* failed\.?)")
+# The usual causes, named next to the sanitizer's words (handouts: Troubleshooting).
+SANITIZER_HINTS = [
+    (("null pointer", "SEGV on unknown address 0x0000"), " (a matrix or vector written before it was sized?)"),
+    (("heap-buffer-overflow", "out of bounds", "stack-buffer-overflow"), " (an index past the end?)"),
+]
+FRAME = re.compile(r"#\d+ 0x[0-9a-f]+ in (.*?) (/\S+?):(\d+)(?::\d+)?$")
+
+
+def sanitizer_report(text, root):
+    """What a sanitizer run printed, in at most three lines: the error, and the
+    first stack frames that lie in the course tree (the student's file first)."""
+    headline = None
+    for line in text.splitlines():
+        line = line.strip()
+        for pattern, form in ((SANITIZER_ERROR, "{1}"), (UBSAN_ERROR, "{2}"), (ASSERTION, "{0}")):
+            match = pattern.search(line)
+            if match and headline is None:
+                headline = form.format(*match.groups())
+                headline = re.sub(r" on (unknown )?address 0x[0-9a-f]+.*", r"", headline)
+                if pattern is UBSAN_ERROR and inside(match.group(1), root):
+                    return [f"{headline} at {relative(match.group(1), root)}:{match.group(2)}"]
+    frames = []
+    for line in text.splitlines():
+        match = FRAME.search(line.strip())
+        if match and inside(match.group(2), root):
+            frames.append((relative(match.group(2), root), match.group(3), match.group(1)))
+    if headline is None and not frames:
+        return []
+    hint = next((h for words, h in SANITIZER_HINTS if headline and any(w in headline for w in words)), "")
+    lines = [f"sanitizer: {headline or 'a report without a headline'}{hint}"]
+    student = next((f for f in frames if f[0].startswith(("labs/", "solutions/"))), None)
+    for frame in dict.fromkeys(f for f in (student, frames[0] if frames else None) if f):
+        function = re.sub(r"\(.*", "", frame[2])
+        lines.append(f"at {frame[0]}:{frame[1]} (in {function})")
+    return lines
+
+
+def inside(path, root):
+    try:
+        Path(path).resolve().relative_to(Path(root).resolve())
+        return True
+    except (ValueError, OSError):
+        return False

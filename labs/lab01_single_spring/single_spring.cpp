@@ -10,7 +10,8 @@ namespace cl::lab01 {
 // Compute d = x_i − x_j, its length, C = length − rest_length, and move each end
 // along n = d / length, the lighter (larger inverse mass) end further. Return
 // zeros when both ends are pinned or the particles coincide; throw
-// std::invalid_argument for a negative inverse mass or rest length.
+// std::invalid_argument for an inverse mass or rest length that is negative or
+// not finite (NaN, inf) — check with std::isfinite from <cmath>.
 // Graded by tests/lab01_single_spring/test_project_distance.cpp.
 DistanceCorrection project_distance(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j,
                                     double inv_mass_i, double inv_mass_j, double rest_length) {
@@ -19,7 +20,10 @@ DistanceCorrection project_distance(const Eigen::Vector3d& x_i, const Eigen::Vec
 }
 
 // TODO(lab01.2) [3 pts] The general projection Δp_k = −C · w_k ∇_k C / Σ_j w_j ‖∇_j C‖².
-// Check the shapes, form the denominator, return zeros when it is 0.
+// Check the shapes (one inverse mass per gradient column), that C and the
+// gradients are finite and the inverse masses finite and >= 0 (else throw
+// std::invalid_argument); form the denominator, return zeros when it is 0.
+// The result is 3 x n: give it its size before writing into its columns.
 // Graded by tests/lab01_single_spring/test_project_constraint.cpp.
 Eigen::Matrix3Xd project_constraint(double constraint, const Eigen::Matrix3Xd& gradients,
                                     const Eigen::VectorXd& inv_mass) {

@@ -139,6 +139,7 @@ int main(int argc, char** argv) {
   options.scene = "perturbed-chain";
   options.iterations = 100;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary);
+  app.get_option("--iterations")->description("Gauss-Seidel sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   const std::vector<std::string> orders{"forward", "reverse", "random"};
   app.add_option("--order", lab.order, "spring order of every sweep (random: a new shuffle per sweep)")

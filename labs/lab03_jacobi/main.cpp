@@ -138,6 +138,7 @@ int main(int argc, char** argv) {
   options.methods = {"jacobi", "gauss-seidel"};
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary);
+  app.get_option("--iterations")->description("sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   lab.threads = omp_get_max_threads();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor (0 leaves x unchanged; >= 2 diverges)")

@@ -3,6 +3,7 @@
 #include "pbd.h"
 
 #include "common/not_implemented.h"
+#include "gauss_seidel.h"  // lab02::gauss_seidel_sweep (pbd.h brings in only lab 03's jacobi.h)
 
 namespace cl::lab04 {
 

@@ -1,4 +1,4 @@
-// Every rejection rule of COURSE.md §3, run through a real lab executable:
+// Every rejection rule of docs/DESIGN.md §3, run through a real lab executable:
 // exit code 2, one stderr line naming the file and the field, no output left.
 #include <sys/wait.h>
 

@@ -1,4 +1,5 @@
 // Graded tests for lab01.2, project_constraint (the general gradient form).
+#include <cmath>
 #include <random>
 
 #include <catch2/catch.hpp>
@@ -55,7 +56,7 @@ TEST_CASE("a linear constraint is satisfied by one projection", "[lab01][pts=1]"
   }
 }
 
-TEST_CASE("degenerate and invalid input to the general form", "[lab01][pts=1]") {
+TEST_CASE("degenerate input gives zeros and invalid input throws in the general form", "[lab01][pts=1]") {
   Matrix3Xd gradients(3, 2);
   gradients << Vector3d(1, 0, 0), Vector3d(-1, 0, 0);
   SECTION("every particle pinned: zeros") {
@@ -68,8 +69,13 @@ TEST_CASE("degenerate and invalid input to the general form", "[lab01][pts=1]") 
     REQUIRE(correction.cols() == 2);
     REQUIRE(correction.isZero(0.0));
   }
-  SECTION("shapes disagree or a mass is negative: std::invalid_argument") {
+  SECTION("shapes disagree, or a mass, C or a gradient is negative or non-finite: std::invalid_argument") {
     REQUIRE_THROWS_AS(cl::lab01::project_constraint(0.5, gradients, VectorXd::Ones(3)), std::invalid_argument);
     REQUIRE_THROWS_AS(cl::lab01::project_constraint(0.5, gradients, VectorXd{{1.0, -1.0}}), std::invalid_argument);
+    REQUIRE_THROWS_AS(cl::lab01::project_constraint(0.5, gradients, VectorXd{{1.0, HUGE_VAL}}), std::invalid_argument);
+    REQUIRE_THROWS_AS(cl::lab01::project_constraint(std::nan(""), gradients, VectorXd::Ones(2)), std::invalid_argument);
+    Matrix3Xd bad_gradients = gradients;
+    bad_gradients(1, 1) = std::nan("");
+    REQUIRE_THROWS_AS(cl::lab01::project_constraint(0.5, bad_gradients, VectorXd::Ones(2)), std::invalid_argument);
   }
 }

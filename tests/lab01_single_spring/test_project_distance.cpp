@@ -57,6 +57,11 @@ void check_exact_length(double scale) {
 
 TEST_CASE("one projection restores the rest length exactly", "[lab01][pts=2]") {
   check_exact_length(1.0);
+  // Rest length 0 is valid input: the ends meet.
+  const Vector3d a(0, 0, 0), b(1, 0, 0);
+  const DistanceCorrection correction = project_distance(a, b, 1.0, 1.0, 0.0);
+  CAPTURE(correction.dx_i.transpose(), correction.dx_j.transpose());
+  REQUIRE(((a + correction.dx_i) - (b + correction.dx_j)).norm() == 0.0);
 }
 
 TEST_CASE("the correction splits by inverse mass along the constraint", "[lab01][pts=1]") {
@@ -132,13 +137,16 @@ TEST_CASE("coordinates scaled by 1e6 and 1e-6 still project exactly", "[lab01][p
   for (double scale : {1e-6, 1e6}) check_exact_length(scale);
 }
 
-TEST_CASE("invalid arguments throw std::invalid_argument", "[lab01][pts=1]") {
+TEST_CASE("negative or non-finite inverse masses and rest lengths throw std::invalid_argument", "[lab01][pts=1]") {
   const Vector3d a(0, 0, 0), b(1, 0, 0);
+  const double nan = std::nan(""), inf = HUGE_VAL;
   REQUIRE_THROWS_AS(project_distance(a, b, -1.0, 1.0, 1.0), std::invalid_argument);
   REQUIRE_THROWS_AS(project_distance(a, b, 1.0, -1.0, 1.0), std::invalid_argument);
   REQUIRE_THROWS_AS(project_distance(a, b, 1.0, 1.0, -0.5), std::invalid_argument);
-  REQUIRE_THROWS_AS(project_distance(a, b, std::nan(""), 1.0, 1.0), std::invalid_argument);
-  // Rest length 0 is allowed: the ends meet.
-  const DistanceCorrection correction = project_distance(a, b, 1.0, 1.0, 0.0);
-  REQUIRE(((a + correction.dx_i) - (b + correction.dx_j)).norm() == 0.0);
+  for (const double bad : {nan, inf}) {
+    CAPTURE(bad);
+    REQUIRE_THROWS_AS(project_distance(a, b, bad, 1.0, 1.0), std::invalid_argument);
+    REQUIRE_THROWS_AS(project_distance(a, b, 1.0, bad, 1.0), std::invalid_argument);
+    REQUIRE_THROWS_AS(project_distance(a, b, 1.0, 1.0, bad), std::invalid_argument);
+  }
 }

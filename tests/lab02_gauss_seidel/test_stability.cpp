@@ -1,4 +1,4 @@
-// Graded test for lab02.1 at the extremes (COURSE.md §6): the shipped
+// Graded test for lab02.1 at the extremes (docs/DESIGN.md §6): the shipped
 // stability scenes stay finite for 10,000 sweeps.
 #include <numeric>
 #include <string>
