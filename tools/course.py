@@ -40,6 +40,7 @@ usage: ./course COMMAND [ARGS]
   plots [DIR]                        figures from the CSV/JSON in DIR (out/)
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
   extremes [--quick]                 the extremes matrix: finite, reported or silent NaN -> out/bench
+  fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
@@ -888,6 +889,7 @@ def cmd_test(argv):
         check_stubs(checks, labs)
         check_demo(checks, out, labs)
         check_measurements(checks, out)
+        check_fuzz(checks)
     for script, (status, error) in run_plots(out, echo=False).items():
         checks.record(status in ("ok", "skipped") if is_release() else status == "ok",
                       f"plots/{script} on {show(out)}: {status}", error)
@@ -984,6 +986,50 @@ def check_measurements(checks, out):
                       [] if code == 0 else lines[-20:])
 
 
+def run_fuzz(seconds, log=sys.stdout):
+    """Build fuzz/ with clang++ into BUILD/fuzz and fuzz the scene loader for SECONDS,
+    starting from every shipped scene. Return (ok, last lines of libFuzzer's output)."""
+    fuzz_build = BUILD / "fuzz"
+    if shutil.which("clang++") is None:
+        raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
+    if not (fuzz_build / "CMakeCache.txt").is_file():
+        quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), "-DCMAKE_CXX_COMPILER=clang++",
+               "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], "configure fuzz/")
+    build_targets(["fuzz_scene"], build_dir=fuzz_build, log=log)
+    corpus = fuzz_build / "corpus"
+    corpus.mkdir(exist_ok=True)
+    for scene in ROOT.glob("labs/*/scenes/*.json"):
+        shutil.copy(scene, corpus / scene.name)
+    artifacts = fuzz_build / "crashes"
+    artifacts.mkdir(exist_ok=True)
+    done = subprocess.run([str(fuzz_build / "fuzz_scene"), f"-max_total_time={seconds}", "-rss_limit_mb=2048",
+                           "-max_len=4096", f"-artifact_prefix={artifacts}/", str(corpus)],
+                          cwd=fuzz_build, capture_output=True, text=True, check=False)
+    lines = [line for line in done.stderr.splitlines() if line.strip()]
+    return done.returncode == 0, lines[-12:]
+
+
+def cmd_fuzz(argv):
+    parser = argparse.ArgumentParser(prog="course fuzz")
+    parser.add_argument("seconds", nargs="?", type=int, default=60, help="how long to fuzz (default 60)")
+    args = parser.parse_args(argv)
+    ok, lines = run_fuzz(args.seconds)
+    for line in lines:
+        print(line)
+    print("fuzz: no crash" if ok else f"fuzz: a crash; the input is in {show(BUILD / 'fuzz' / 'crashes')}/")
+    return 0 if ok else 1
+
+
+def check_fuzz(checks, seconds=60):
+    try:
+        ok, lines = run_fuzz(seconds, log=None)
+    except (CourseError, BuildFailure) as error:
+        checks.record(False, f"fuzz the scene loader: {error}")
+        return
+    runs = next((line for line in reversed(lines) if line.startswith("Done ")), "")
+    checks.record(ok, f"fuzz the scene loader for {seconds} s: {runs or 'no summary'}", [] if ok else lines)
+
+
 def cmd_autograder(argv):
     import autograder  # here: it imports this module
     return autograder.cmd_autograder(argv)
@@ -992,7 +1038,7 @@ def cmd_autograder(argv):
 # ---------------------------------------------------------------- main
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
-            "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "release": cmd_release, "autograder": cmd_autograder}
+            "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "release": cmd_release, "autograder": cmd_autograder}
 
 
 def main(argv):
