@@ -360,11 +360,13 @@ def plot_scripts():
     return sorted(p for p in (ROOT / "plots").glob("*.py") if not p.name.startswith("_"))
 
 
-def run_plots(directory, echo=True):
-    """Run every plot script on DIRECTORY; return {script: (ok|skipped|failed, error lines)}."""
+def run_plots(directory, echo=True, names=None):
+    """Run every plot script (or those named) on DIRECTORY; return {script: (ok|skipped|failed, error lines)}."""
     env = dict(os.environ, MPLBACKEND="Agg")
     outcomes = {}
     for script in plot_scripts():
+        if names is not None and script.name not in names:
+            continue
         done = subprocess.run([sys.executable, str(script.relative_to(ROOT)), str(directory)],
                               cwd=ROOT, env=env, capture_output=True, text=True, check=False)
         if done.returncode == 0:
@@ -920,16 +922,19 @@ def cmd_run(argv):
     os.execv(program, [str(program), *argv[1:]])
 
 
+MEASUREMENT_PLOTS = {"trade": ("bench_pareto.py", "bench_scaling.py"), "extremes": ("bench_extremes.py",)}
+
+
 def run_measurement(program, args, out, echo=True):
-    """Build and run bench/PROGRAM (trade or extremes) into OUT/bench; return its exit code."""
-    build_targets([program])
+    """Build and run bench/PROGRAM (trade or extremes) into OUT/bench.
+    Return (exit code, output lines); with echo the output goes to the terminal as it comes."""
+    build_targets([program], log=sys.stdout if echo else None)
     path = executable(program)
     command = [str(path), "--out", str(out / "bench"), *args]
     if echo:
         print("  " + shlex.join([path.name, *command[1:]]), flush=True)
-        return subprocess.run(command, cwd=ROOT, check=False).returncode
-    done = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, check=False)
-    return done.returncode, (done.stdout + done.stderr).splitlines()
+    done = subprocess.run(command, cwd=ROOT, capture_output=not echo, text=True, check=False)
+    return done.returncode, [] if echo else (done.stdout + done.stderr).splitlines()
 
 
 def measurement_command(program, argv):
@@ -943,11 +948,9 @@ def measurement_command(program, argv):
     args = parser.parse_args(argv)
     configure()
     out = under_root(args.out)
-    code = run_measurement(program, ["--quick"] if args.quick else [], out)
-    scripts = {"trade": ("bench_pareto.py", "bench_scaling.py"), "extremes": ("bench_extremes.py",)}[program]
-    env = dict(os.environ, MPLBACKEND="Agg")
-    for script in scripts:
-        subprocess.run([sys.executable, str(ROOT / "plots" / script), str(out)], cwd=ROOT, env=env, check=False)
+    code, _ = run_measurement(program, ["--quick"] if args.quick else [], out)
+    if plots_failed(run_plots(out, names=MEASUREMENT_PLOTS[program])):
+        code = max(code, 1)
     if program == "trade" and args.micro is not None:
         code = max(code, run_micro(args.micro))
     return code
