@@ -19,6 +19,12 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
+// The generators' size caps: a cloth of 1024 × 1024 particles (about 200 MB
+// with its springs and triangles), a chain of as many. Larger is a typo, not a
+// scene: 4096² would take 3.5 GB before the first step.
+constexpr std::int64_t kMaxClothSide = 1024;
+constexpr std::int64_t kMaxChainLinks = kMaxClothSide * kMaxClothSide;
+
 std::string show(const json& value) {
   std::string text = value.dump();
   if (text.size() > 40) text = text.substr(0, 37) + "...";
@@ -63,6 +69,15 @@ class Reader {
   double positive(const json& value, const std::string& field) const {
     const double result = number(value, field);
     if (!(result > 0.0)) fail(field, "must be > 0 (got " + show(value) + ")");
+    return result;
+  }
+
+  // A mass in kg whose inverse, which the solvers use, is a finite double too.
+  double mass(const json& value, const std::string& field, double particles = 1.0) const {
+    const double result = positive(value, field);
+    if (!std::isfinite(particles / result)) {
+      fail(field, "too small: the inverse mass of a particle overflows a double (got " + show(value) + ")");
+    }
     return result;
   }
 
@@ -169,7 +184,7 @@ void read_particles(const Reader& reader, const json& list, Scene& scene) {
     const auto n = static_cast<Eigen::Index>(p);
     scene.particles.x.col(n) = reader.vec3(entry["x"], field + ".x");
     if (entry.contains("v")) scene.particles.v.col(n) = reader.vec3(entry["v"], field + ".v");
-    const double mass = entry.contains("mass") ? reader.positive(entry["mass"], field + ".mass") : 1.0;
+    const double mass = entry.contains("mass") ? reader.mass(entry["mass"], field + ".mass") : 1.0;
     const bool pinned = entry.contains("pinned") && reader.boolean(entry["pinned"], field + ".pinned");
     scene.particles.inv_mass[n] = pinned ? 0.0 : 1.0 / mass;
   }
@@ -231,6 +246,9 @@ void read_triangles(const Reader& reader, const json& list, Scene& scene) {
                              std::to_string(triangle.j) + ", " + std::to_string(triangle.k) + ")");
     }
     triangle.rest_area = triangle_area(scene.particles.x, triangle.i, triangle.j, triangle.k);
+    if (!std::isfinite(triangle.rest_area)) {
+      reader.fail(field, "its area overflows a double (particles too far apart)");
+    }
     if (degenerate_area(scene.particles.x, triangle.i, triangle.j, triangle.k, triangle.rest_area)) {
       reader.fail(field, "zero rest area (its three particles are collinear or coincident)");
     }
@@ -250,11 +268,11 @@ void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
                             "plane", "triangles"},
                     field);
   auto get = [&](const char* key) -> const json* { return cloth.contains(key) ? &cloth[key] : nullptr; };
-  const int nx = get("nx") ? reader.integer_at_least(*get("nx"), "cloth.nx", 2, 4096) : 16;
-  const int ny = get("ny") ? reader.integer_at_least(*get("ny"), "cloth.ny", 2, 4096) : nx;
+  const int nx = get("nx") ? reader.integer_at_least(*get("nx"), "cloth.nx", 2, kMaxClothSide) : 16;
+  const int ny = get("ny") ? reader.integer_at_least(*get("ny"), "cloth.ny", 2, kMaxClothSide) : nx;
   const double width = get("width") ? reader.positive(*get("width"), "cloth.width") : 1.0;
   const double height = get("height") ? reader.positive(*get("height"), "cloth.height") : 1.0;
-  const double mass = get("mass") ? reader.positive(*get("mass"), "cloth.mass") : 1.0;
+  const double mass = get("mass") ? reader.mass(*get("mass"), "cloth.mass", static_cast<double>(nx) * ny) : 1.0;
   const double stiffness = get("stiffness") ? reader.stiffness(*get("stiffness"), "cloth.stiffness")
                                             : kInfiniteStiffness;
   const std::string plane = get("plane") ? reader.one_of(*get("plane"), "cloth.plane", {"xy", "xz"}) : "xy";
@@ -332,9 +350,9 @@ void generate_chain(const Reader& reader, const json& chain, Scene& scene) {
   reader.require_object(chain, "chain");
   reader.check_keys(chain, {"links", "length", "mass", "direction", "origin", "pin", "stiffness"}, "chain");
   auto get = [&](const char* key) -> const json* { return chain.contains(key) ? &chain[key] : nullptr; };
-  const int links = get("links") ? reader.integer_at_least(*get("links"), "chain.links", 1) : 10;
+  const int links = get("links") ? reader.integer_at_least(*get("links"), "chain.links", 1, kMaxChainLinks) : 10;
   const double length = get("length") ? reader.positive(*get("length"), "chain.length") : 1.0;
-  const double mass = get("mass") ? reader.positive(*get("mass"), "chain.mass") : 1.0;
+  const double mass = get("mass") ? reader.mass(*get("mass"), "chain.mass") : 1.0;
   Eigen::Vector3d direction(1.0, 0.0, 0.0);
   if (get("direction")) {
     direction = reader.vec3(*get("direction"), "chain.direction");
@@ -394,6 +412,8 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
   bool start_object(std::size_t n) override { return open(false) && dom_.start_object(n); }
   bool key(string_t& k) override {
     path_.back().key = k;
+    // JSON parsers keep one of two equal keys silently; a scene says it once.
+    if (!path_.back().keys.insert(k).second) throw InputError(source_ + ": " + here() + ": duplicate key");
     return dom_.key(k);
   }
   bool end_object() override { return close() && dom_.end_object(); }
@@ -415,11 +435,12 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
     bool array = false;
     long index = -1;
     std::string key;
+    std::set<std::string> keys;  // an object's keys so far
   };
 
   bool open(bool array) {
     before_value();
-    path_.push_back(Level{array, -1, {}});
+    path_.push_back(Level{array, -1, {}, {}});
     return true;
   }
   bool close() {
@@ -452,6 +473,32 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
   std::string source_;
   std::vector<Level> path_;
 };
+
+// Finite inputs can still make infinite geometry: positions 1e308 apart, a
+// chain of 1e308 m links, a jitter of 1e308. Every position, every spring's
+// rest and current length and every triangle's rest and current area must be
+// a finite double, or the solvers' first norm overflows. `field` names what
+// set the sizes.
+void check_finite_geometry(const Reader& reader, const Scene& scene, const std::string& field) {
+  const Eigen::Matrix3Xd& x = scene.particles.x;
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    if (!x.col(p).allFinite()) reader.fail(field, "positions overflow a double (particle " + std::to_string(p) + ")");
+  }
+  const bool listed = field == "particles";
+  for (std::size_t s = 0; s < scene.springs.size(); ++s) {
+    const Spring& spring = scene.springs[s];
+    if (!std::isfinite(spring.rest_length) || !std::isfinite((x.col(spring.i) - x.col(spring.j)).norm())) {
+      reader.fail(listed ? item("springs", s) : field, "its length overflows a double (particles too far apart)");
+    }
+  }
+  for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
+    const Triangle& triangle = scene.triangles[t];
+    if (!std::isfinite(triangle.rest_area) ||
+        !std::isfinite(triangle_area(x, triangle.i, triangle.j, triangle.k))) {
+      reader.fail(listed ? item("triangles", t) : field, "its area overflows a double (particles too far apart)");
+    }
+  }
+}
 
 }  // namespace
 
@@ -490,7 +537,11 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     if (root.contains("cloth")) generate_cloth(reader, root["cloth"], scene);
     if (root.contains("chain")) generate_chain(reader, root["chain"], scene);
   }
-  if (root.contains("jitter")) apply_jitter(reader, root["jitter"], scene);
+  check_finite_geometry(reader, scene, root.contains("cloth") ? "cloth" : root.contains("chain") ? "chain" : "particles");
+  if (root.contains("jitter")) {
+    apply_jitter(reader, root["jitter"], scene);
+    check_finite_geometry(reader, scene, "jitter.amplitude");
+  }
   return scene;
 }
 

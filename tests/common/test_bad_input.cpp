@@ -81,6 +81,12 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
       {"stiffness zero", std::string("{") + kTwo + R"(, "springs": [{"i": 0, "j": 1, "stiffness": 0}]})",
        "springs[0].stiffness"},
       {"stiffness negative", R"({"chain": {"links": 2, "stiffness": -5}})", "chain.stiffness"},
+      {"chain too long", R"({"chain": {"links": 100000000}})", "chain.links"},
+      {"duplicate key", R"({"particles": [{"x": [0,0,0], "x": [1,0,0]}]})", "particles[0].x"},
+      {"inverse mass overflows", R"({"particles": [{"x": [0,0,0], "mass": 1e-320}]})", "particles[0].mass"},
+      {"length overflows", R"({"particles": [{"x": [0,0,0]}, {"x": [1e200,0,0]}], "springs": [{"i": 0, "j": 1}]})",
+       "springs[0]"},
+      {"cloth too wide", R"({"cloth": {"nx": 5000}})", "cloth.nx"},
       {"cloth unknown pin", R"({"cloth": {"nx": 4, "pin": ["centre"]}})", "cloth.pin[0]"},
   };
   int index = 0;
