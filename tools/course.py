@@ -41,6 +41,7 @@ usage: ./course COMMAND [ARGS]
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
   extremes [--quick]                 the extremes matrix: finite, reported or silent NaN -> out/bench
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
+  sanitize                           the whole test suite under AddressSanitizer and UBSan (build/asan)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
@@ -781,6 +782,76 @@ def check_demo(checks, out, labs, student_fallback=True):
     checks.record(True, f"demo -> {show(out)}/")
 
 
+def reject_lines(lab):
+    """labs/LAB/rejects.txt: (arguments, expected text) per line `ARGS -> TEXT`."""
+    path = ROOT / "labs" / lab / "rejects.txt"
+    if not path.is_file():
+        return []
+    found = []
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        args, arrow, expected = line.rpartition(" -> ")
+        if not arrow or not args.strip() or not expected.strip():
+            raise CourseError(f"{show(path)}:{number}: expected `ARGS -> TEXT`")
+        found.append((shlex.split(args), expected.strip()))
+    return found
+
+
+def refusal_problem(program, args, expected):
+    """Run PROGRAM on one bad input in a scratch folder; what is wrong with how
+    it refused (None: exit code 2, one stderr line containing EXPECTED, nothing
+    written). A --scene argument that starts with `{` is JSON, written to
+    scratch/bad.json first; `{tmp}` is the scratch folder."""
+    with tempfile.TemporaryDirectory(prefix="cl-reject-") as scratch:
+        scratch = Path(scratch)
+        argv = [arg.replace("{tmp}", str(scratch)) for arg in args]
+        for i in range(1, len(argv)):
+            if argv[i - 1] == "--scene" and argv[i].startswith("{"):
+                (scratch / "bad.json").write_text(argv[i])
+                argv[i] = str(scratch / "bad.json")
+        before = sorted(scratch.rglob("*"))
+        try:
+            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True, text=True,
+                                  timeout=60, check=False)
+        except subprocess.TimeoutExpired:
+            return "ran past 60 s instead of refusing"
+        lines = done.stderr.splitlines()
+        if done.returncode != 2:
+            return f"exit code {done.returncode}, not 2; stderr: {' | '.join(lines[-3:]) or '(empty)'}"
+        if len(lines) != 1:
+            return f"{len(lines)} stderr lines, not 1: {' | '.join(lines[:3])}"
+        if expected not in lines[0]:
+            return f"the line does not say '{expected}': {lines[0]}"
+        written = [str(p.relative_to(scratch)) for p in sorted(scratch.rglob("*")) if p not in before]
+        if written:
+            return f"left output behind: {', '.join(written[:3])}"
+    return None
+
+
+def check_rejects(checks, labs):
+    """Every line of labs/*/rejects.txt: the lab's executable refuses it (docs/DESIGN.md §3)."""
+    entries = manifest()
+    for lab in labs:
+        try:
+            cases = reject_lines(lab)
+        except CourseError as error:
+            checks.record(False, str(error))
+            continue
+        if not cases:
+            continue
+        name = lab + ("_solution" if entries[lab]["reference"] else "")
+        program = BIN / name
+        problems = []
+        for args, expected in cases:
+            problem = refusal_problem(program, args, expected)
+            if problem:
+                problems.append(f"{shlex.join(args)}: {problem}")
+        checks.record(not problems, f"{lab} refuses {len(cases) - len(problems)}/{len(cases)} bad inputs "
+                      f"(labs/{lab}/rejects.txt: exit 2, one line, nothing written)", problems)
+
+
 def sub_course(tree, *args):
     """Run tree's own ./course (its tools/course.py) with its own build dir."""
     env = dict(os.environ, CL_BUILD_DIR=str(tree / "build"))
@@ -882,6 +953,7 @@ def cmd_test(argv):
         report_student_score(labs)
         with_reference = [lab for lab in labs if manifest()[lab]["reference"]]
         check_demo(checks, out, with_reference, student_fallback=False)
+        check_rejects(checks, with_reference)
     else:
         without = [lab for lab in labs if not manifest()[lab]["reference"]]
         for lab in without:
@@ -890,8 +962,10 @@ def cmd_test(argv):
         check_solutions(checks, labs)
         check_stubs(checks, labs)
         check_demo(checks, out, labs)
+        check_rejects(checks, labs)
         check_measurements(checks, out)
         check_fuzz(checks)
+        check_sanitize(checks)
     for script, (status, error) in run_plots(out, echo=False).items():
         checks.record(status in ("ok", "skipped") if is_release() else status == "ok",
                       f"plots/{script} on {show(out)}: {status}", error)
@@ -956,8 +1030,18 @@ def measurement_command(program, argv):
     return code
 
 
+def micro_targets():
+    """The Google Benchmark programs: bench/bench_NAME.cpp is the target bench_NAME,
+    where this build defines it (bench/CMakeLists.txt adds those whose references exist)."""
+    names = sorted(path.stem for path in (ROOT / "bench").glob("bench_*.cpp"))
+    return [name for name in names if (BUILD / "bench" / "CMakeFiles" / f"{name}.dir").is_dir()]
+
+
 def run_micro(argv):
-    targets = ["bench_sweeps", "bench_lab06", "bench_lab07"]
+    targets = micro_targets()
+    if not targets:
+        raise CourseError("no Google Benchmark program in this build (bench/bench_*.cpp need "
+                          "libbenchmark-dev and the labs' references)")
     build_targets(targets)
     failed = []
     for name in targets:
@@ -989,9 +1073,14 @@ def check_measurements(checks, out):
                       [] if code == 0 else lines[-20:])
 
 
+REGRESSIONS = ROOT / "tests" / "common" / "scene_regressions"
+
+
 def run_fuzz(seconds, log=sys.stdout):
     """Build fuzz/ with clang++ into BUILD/fuzz and fuzz the scene loader for SECONDS,
-    starting from every shipped scene. Return (ok, last lines of libFuzzer's output)."""
+    starting from every shipped scene and saved regression input, with the scene
+    format's dictionary. A crashing input is copied into tests/common/scene_regressions/.
+    Return (ok, last lines of libFuzzer's output, the copied inputs)."""
     fuzz_build = BUILD / "fuzz"
     if shutil.which("clang++") is None:
         raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
@@ -1001,36 +1090,113 @@ def run_fuzz(seconds, log=sys.stdout):
     build_targets(["fuzz_scene"], build_dir=fuzz_build, log=log)
     corpus = fuzz_build / "corpus"
     corpus.mkdir(exist_ok=True)
-    for scene in ROOT.glob("labs/*/scenes/*.json"):
-        shutil.copy(scene, corpus / scene.name)
+    seeds = [*ROOT.glob("labs/*/scenes/*.json"), *(p for p in REGRESSIONS.glob("*") if p.name != "README.md")]
+    for seed in seeds:
+        shutil.copy(seed, corpus / f"seed-{seed.name}")
     artifacts = fuzz_build / "crashes"
-    artifacts.mkdir(exist_ok=True)
+    shutil.rmtree(artifacts, ignore_errors=True)
+    artifacts.mkdir()
     done = subprocess.run([str(fuzz_build / "fuzz_scene"), f"-max_total_time={seconds}", "-rss_limit_mb=2048",
-                           "-max_len=4096", f"-artifact_prefix={artifacts}/", str(corpus)],
+                           "-max_len=4096", f"-dict={ROOT / 'fuzz' / 'scene.dict'}",
+                           f"-artifact_prefix={artifacts}/", str(corpus)],
                           cwd=fuzz_build, capture_output=True, text=True, check=False)
     lines = [line for line in done.stderr.splitlines() if line.strip()]
-    return done.returncode == 0, lines[-12:]
+    kept = []
+    for artifact in sorted(artifacts.iterdir()):
+        target = REGRESSIONS / artifact.name
+        shutil.copy(artifact, target)
+        kept.append(target)
+    return done.returncode == 0, lines[-12:], kept
 
 
 def cmd_fuzz(argv):
     parser = argparse.ArgumentParser(prog="course fuzz")
     parser.add_argument("seconds", nargs="?", type=int, default=60, help="how long to fuzz (default 60)")
     args = parser.parse_args(argv)
-    ok, lines = run_fuzz(args.seconds)
+    ok, lines, kept = run_fuzz(args.seconds)
     for line in lines:
         print(line)
-    print("fuzz: no crash" if ok else f"fuzz: a crash; the input is in {show(BUILD / 'fuzz' / 'crashes')}/")
-    return 0 if ok else 1
+    if ok:
+        print("fuzz: no crash")
+        return 0
+    for path in kept:
+        print(f"fuzz: a crashing input, kept as a regression test: {show(path)}")
+    print("fuzz: fix the loader until ./course test passes, then commit the input with the fix")
+    return 1
 
 
 def check_fuzz(checks, seconds=60):
     try:
-        ok, lines = run_fuzz(seconds, log=None)
+        ok, lines, kept = run_fuzz(seconds, log=None)
     except (CourseError, BuildFailure) as error:
         checks.record(False, f"fuzz the scene loader: {error}")
         return
     runs = next((line for line in reversed(lines) if line.startswith("Done ")), "")
-    checks.record(ok, f"fuzz the scene loader for {seconds} s: {runs or 'no summary'}", [] if ok else lines)
+    details = [] if ok else [*lines, *(f"kept as a regression test: {show(path)}" for path in kept)]
+    checks.record(ok, f"fuzz the scene loader for {seconds} s: {runs or 'no summary'}", details)
+
+
+SANITIZE_BUILD = BUILD / "asan"
+SANITIZE_OPTIONS = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0:allow_user_segv_handler=0:handle_abort=1",
+                    "UBSAN_OPTIONS": "print_stacktrace=1:halt_on_error=1"}
+
+
+def sanitize_targets():
+    """The whole test suite: common_tests and every lab's graded tests on its reference."""
+    labs = [lab for lab, entry in manifest().items() if entry["reference"]]
+    return ["common_tests", *(f"{lab}_tests_solution" for lab in labs)]
+
+
+def run_sanitized(log=sys.stdout):
+    """Build the test suite with -fsanitize=address,undefined (CMakeLists.txt: CL_SANITIZE)
+    into BUILD/asan and run every test program there, every case (hidden ones too).
+    Return [(program, ok, summary line, report lines)]."""
+    configure(log=log)  # labs.json says which labs have a reference
+    if not (SANITIZE_BUILD / "CMakeCache.txt").is_file():
+        quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), "-DCL_SANITIZE=ON",
+               "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"],
+              "configure the sanitizer build")
+    targets = sanitize_targets()
+    build_targets(targets, build_dir=SANITIZE_BUILD, log=log, label="the test suite (-fsanitize=address,undefined)")
+    env = dict(os.environ, **SANITIZE_OPTIONS)
+    results = []
+    for name in targets:
+        start = time.monotonic()
+        with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
+            done = subprocess.run([str(SANITIZE_BUILD / "bin" / name)], cwd=work, env=env, capture_output=True,
+                                  text=True, check=False)
+        output = done.stdout + done.stderr
+        report = grade.sanitizer_report(output, ROOT)
+        ok = done.returncode == 0 and not report
+        lines = output.splitlines()
+        summary = next((line for line in reversed(lines) if "test cases" in line or "All tests passed" in line),
+                       f"exit code {done.returncode}")
+        results.append((name, ok, f"{summary.strip()} ({time.monotonic() - start:.1f} s)",
+                        report or ([] if ok else lines[-20:])))
+    return results
+
+
+def cmd_sanitize(argv):
+    argparse.ArgumentParser(prog="course sanitize").parse_args(argv)
+    failed = 0
+    for name, ok, summary, report in run_sanitized():
+        print(f"{'ok  ' if ok else 'FAIL'}  {name}: {summary}")
+        for line in report:
+            print(f"        {line}")
+        failed += not ok
+    print("sanitize: clean" if not failed else f"sanitize: {failed} program(s) with findings or failures")
+    return 1 if failed else 0
+
+
+def check_sanitize(checks):
+    """CI: the whole test suite under ASan and UBSan, clean."""
+    try:
+        results = run_sanitized(log=None)
+    except (CourseError, BuildFailure) as error:
+        checks.record(False, f"sanitizer build: {error}", getattr(error, "lines", getattr(error, "details", [])))
+        return
+    for name, ok, summary, report in results:
+        checks.record(ok, f"{name} under ASan+UBSan: {summary}", report)
 
 
 def cmd_autograder(argv):
@@ -1041,7 +1207,8 @@ def cmd_autograder(argv):
 # ---------------------------------------------------------------- main
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
-            "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "release": cmd_release, "autograder": cmd_autograder}
+            "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
+            "release": cmd_release, "autograder": cmd_autograder}
 
 
 def main(argv):
