@@ -32,4 +32,12 @@ double energy_scale(const Particles& particles, const Eigen::Vector3d& gravity, 
   return scale > 0.0 ? scale : at_rest_scale;
 }
 
+std::string energy_rise_problem(double rise, double scale, const std::string& measured) {
+  if (!(scale > 0.0) || !(rise > scale)) return {};
+  const char* format = "%s rose %.3g J above its start (more than the scene's %.3g J): unstable";
+  std::string text(static_cast<std::size_t>(std::snprintf(nullptr, 0, format, measured.c_str(), rise, scale)), '\0');
+  std::snprintf(text.data(), text.size() + 1, format, measured.c_str(), rise, scale);
+  return text;
+}
+
 }  // namespace cl

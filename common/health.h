@@ -27,4 +27,13 @@ std::string health_problem(const Particles& particles, const StrainStats& strain
 // add it to the start; labs with springs add their own potential.)
 double energy_scale(const Particles& particles, const Eigen::Vector3d& gravity, double dt);
 
+// The verdict on an energy rise, J: `rise` is the measured energy minus its
+// value at the start, `scale` the most the scene may gain (energy_scale, plus
+// whatever the lab adds). Empty when rise <= scale; otherwise one line,
+//     "<measured> rose <rise> J above its start (more than the scene's <scale> J): unstable"
+// (both numbers to 3 significant digits). `measured` names what the lab sums
+// ("total energy", "kinetic + potential energy"). scale <= 0 turns the check
+// off; a NaN rise is not reported here (health_problem sees the state first).
+std::string energy_rise_problem(double rise, double scale, const std::string& measured = "total energy");
+
 }  // namespace cl
