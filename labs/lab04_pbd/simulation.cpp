@@ -2,13 +2,11 @@
 #include "simulation.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <deque>
 #include <stdexcept>
 #include <string>
 
 #include "common/timer.h"
+#include "common/window_means.h"
 
 namespace cl::lab04 {
 
@@ -55,8 +53,7 @@ RunResult run_frames(Particles& particles, const ConstraintSet& constraints, con
     return result;
   }
 
-  std::deque<double> window_means;  // the last three windows' mean max strain
-  double sum_max = 0.0, sum_rms = 0.0;
+  WindowMeans max_strain(plan.window_frames), rms_strain(plan.window_frames);
   for (int f = 1; f <= plan.frames; ++f) {
     const Timer timer;
     advance_frame(particles, constraints, frame, substeps);
@@ -69,39 +66,25 @@ RunResult run_frames(Particles& particles, const ConstraintSet& constraints, con
     const double rise = result.energy_end - result.energy_start;
     result.max_energy_rise = std::max(result.max_energy_rise, rise);
     record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty() && result.energy_scale > 0.0 && rise > result.energy_scale) {
-      char text[160];
-      std::snprintf(text, sizeof text, "total energy rose %.3g J above its start (more than the scene's %.3g J): unstable",
-                    rise, result.energy_scale);
-      record.problem = text;
-    }
+    if (record.problem.empty()) record.problem = energy_rise_problem(rise, result.energy_scale);
     if (on_frame) on_frame(record, particles);
     result.problem = record.problem;
     if (!result.problem.empty()) {
       result.problem_frame = f;
       return result;
     }
-    sum_max += record.strain.max;
-    sum_rms += record.strain.rms;
-    if (f % plan.window_frames != 0) continue;
+    rms_strain.add(record.strain.rms);
+    if (!max_strain.add(record.strain.max)) continue;
 
     // A window is complete.
     if (result.windows_done > 0) result.previous_window_max_strain = result.window_max_strain;
-    result.window_max_strain = sum_max / plan.window_frames;
-    result.window_rms_strain = sum_rms / plan.window_frames;
-    ++result.windows_done;
-    sum_max = sum_rms = 0.0;
-    window_means.push_back(result.window_max_strain);
-    if (window_means.size() > 3) window_means.pop_front();
-    if (window_means.size() == 3) {
-      const auto [low, high] = std::minmax_element(window_means.begin(), window_means.end());
-      const double spread = *high - *low;
-      const double last = window_means.back();
-      result.window_spread = last > 0.0 ? spread / last : (spread > 0.0 ? 1.0 : 0.0);
-      if (plan.settle_tolerance > 0.0 && spread <= plan.settle_tolerance * last && f >= plan.energy_frame) {
-        result.settled = true;
-        break;
-      }
+    result.window_max_strain = max_strain.last();
+    result.window_rms_strain = rms_strain.last();
+    result.windows_done = max_strain.windows_done();
+    result.window_spread = max_strain.relative_spread();
+    if (max_strain.settled(plan.settle_tolerance) && f >= plan.energy_frame) {
+      result.settled = true;
+      break;
     }
   }
   return result;

@@ -17,7 +17,8 @@ namespace cl::lab04 {
 void advance_frame(Particles& particles, const ConstraintSet& constraints, const PbdSettings& frame,
                    int substeps);
 
-// health_problem, energy_scale and kUnstableStrain live in common/health.h.
+// health_problem, energy_scale, energy_rise_problem and kUnstableStrain live in
+// common/health.h; the averaging windows and the settle test in common/window_means.h.
 
 // What one frame looked like after it was computed (frame 0: the initial state).
 struct FrameRecord {
@@ -35,7 +36,7 @@ struct RunPlan {
   int window_frames = 60;          // frames per averaging window (windows are frames 1…W, W+1…2W, …)
   // > 0: stop after the first window at which the mean max strain of the last
   // three windows agree to this relative spread, (max − min) <= tol · last, and
-  // energy_frame has been passed.
+  // energy_frame has been passed (common/window_means.h).
   double settle_tolerance = 0.0;
   int energy_frame = -1;           // record the total energy after this frame (−1: none)
 };

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -230,13 +229,7 @@ RunResult run_steps(Particles& particles, const LimitedSystem& system, const Ste
     if (record.problem.empty() && !std::isfinite(record.elastic + record.kinetic)) {
       record.problem = "energy is not finite";
     }
-    if (record.problem.empty() && check_energy && result.energy_scale > 0.0 && rise > result.energy_scale) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "total energy rose %.3g J above its start (more than the scene's %.3g J): unstable", rise,
-                    result.energy_scale);
-      record.problem = text;
-    }
+    if (record.problem.empty() && check_energy) record.problem = energy_rise_problem(rise, result.energy_scale);
     if (on_step) on_step(record, particles);
     if (!record.problem.empty()) {
       result.problem = record.problem;

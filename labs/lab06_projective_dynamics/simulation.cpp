@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -363,13 +362,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const StepSettings& se
     record.problem = report.problem;
     if (record.problem.empty()) record.problem = health_problem(particles, record.strain);
     const double rise = result.energy_end - result.energy_start;
-    if (record.problem.empty() && result.energy_scale > 0.0 && rise > result.energy_scale) {
-      char text[160];
-      std::snprintf(text, sizeof text,
-                    "total energy rose %.3g J above its start (more than the scene's %.3g J): unstable", rise,
-                    result.energy_scale);
-      record.problem = text;
-    }
+    if (record.problem.empty()) record.problem = energy_rise_problem(rise, result.energy_scale);
     if (on_step) on_step(record, particles);
     if (!record.problem.empty()) {
       result.problem = record.problem;

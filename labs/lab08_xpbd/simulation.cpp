@@ -3,12 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <deque>
 #include <stdexcept>
 #include <string>
 
 #include "common/timer.h"
+#include "common/window_means.h"
 
 namespace cl::lab08 {
 
@@ -121,8 +120,7 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
     return result;
   }
 
-  std::deque<double> window_means;  // the last three windows' mean total stretch
-  double sum_stretch = 0.0, sum_max = 0.0;
+  WindowMeans stretch(plan.window_frames), max_strain(plan.window_frames);
   for (int f = 1; f <= plan.frames; ++f) {
     const Timer timer;
     advance_frame(particles, constraints, frame, result.lambda);
@@ -134,11 +132,8 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
     result.max_energy_rise = std::max(result.max_energy_rise, result.energy_end - result.energy_start);
     const double rise = mechanical(record) - mechanical_start;
     record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty() && result.energy_scale > 0.0 && rise > result.energy_scale) {
-      char text[160];
-      std::snprintf(text, sizeof text, "kinetic + potential energy rose %.3g J above its start (more than the scene's %.3g J): unstable",
-                    rise, result.energy_scale);
-      record.problem = text;
+    if (record.problem.empty()) {
+      record.problem = energy_rise_problem(rise, result.energy_scale, "kinetic + potential energy");
     }
     if (on_frame) on_frame(record, particles);
     result.problem = record.problem;
@@ -146,25 +141,16 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
       result.problem_frame = f;
       return result;
     }
-    sum_stretch += record.total_stretch;
-    sum_max += record.strain.max;
-    if (f % plan.window_frames != 0) continue;
+    max_strain.add(record.strain.max);
+    if (!stretch.add(record.total_stretch)) continue;
 
-    result.window_total_stretch = sum_stretch / plan.window_frames;
-    result.window_max_strain = sum_max / plan.window_frames;
-    ++result.windows_done;
-    sum_stretch = sum_max = 0.0;
-    window_means.push_back(result.window_total_stretch);
-    if (window_means.size() > 3) window_means.pop_front();
-    if (window_means.size() == 3) {
-      const auto [low, high] = std::minmax_element(window_means.begin(), window_means.end());
-      const double spread = *high - *low;
-      const double last = std::abs(window_means.back());
-      result.window_spread = last > 0.0 ? spread / last : (spread > 0.0 ? 1.0 : 0.0);
-      if (plan.settle_tolerance > 0.0 && spread <= plan.settle_tolerance * last) {
-        result.settled = true;
-        break;
-      }
+    result.window_total_stretch = stretch.last();
+    result.window_max_strain = max_strain.last();
+    result.windows_done = stretch.windows_done();
+    result.window_spread = stretch.relative_spread();
+    if (stretch.settled(plan.settle_tolerance)) {
+      result.settled = true;
+      break;
     }
   }
   return result;

@@ -70,7 +70,8 @@ struct RunPlan {
   int frames = 0;             // frames to run; the most, when settling
   int window_frames = 60;     // frames per averaging window
   // > 0: stop after the first window at which the mean total stretch of the
-  // last three windows agree to this relative spread, (max − min) <= tol · |last|.
+  // last three windows agree to this relative spread, (max − min) <= tol · |last|
+  // (common/window_means.h).
   double settle_tolerance = 0.0;
 };
 

@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -94,12 +93,7 @@ RunResult run_frames(Particles& particles, const ClothHierarchy& hierarchy, cons
     record = measure(f, f * settings.dt, particles, hierarchy, settings.gravity, seconds);
     result.energy_end = record.kinetic + record.potential;
     const double rise = result.energy_end - result.energy_start;
-    if (record.problem.empty() && scale > 0.0 && rise > scale) {
-      char text[160];
-      std::snprintf(text, sizeof text, "total energy rose %.3g J above its start (more than the scene's %.3g J): unstable",
-                    rise, scale);
-      record.problem = text;
-    }
+    if (record.problem.empty()) record.problem = energy_rise_problem(rise, scale);
     if (on_frame) on_frame(record, particles);
     if (!record.problem.empty()) {
       result.problem = record.problem;
