@@ -80,13 +80,7 @@ std::string check_health(const cl::Particles& particles, const cl::Scene& scene,
   std::string problem = cl::health_problem(particles, cl::strain_stats(particles.x, scene.springs));
   if (!problem.empty()) return problem;
   const double rise = total_energy(particles, scene) - energy_start;
-  if (scale > 0.0 && rise > scale) {
-    char text[160];
-    std::snprintf(text, sizeof text,
-                  "total energy rose %.3g J above its start (more than the scene's %.3g J): unstable", rise, scale);
-    return text;
-  }
-  return {};
+  return cl::energy_rise_problem(rise, scale);
 }
 
 cl::lab09::StableSettings settings_for(const cl::Scene& scene, const cl::CommonOptions& options,
