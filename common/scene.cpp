@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -585,6 +587,26 @@ std::vector<std::string> list_scene_names(const std::string& scene_dir) {
   }
   std::sort(names.begin(), names.end());
   return names;
+}
+
+std::string describe(const Scene& scene) {
+  std::ostringstream text;
+  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
+  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
+  text << ")";
+  return text.str();
+}
+
+int frames_in(double seconds, double dt) {
+  if (std::isnan(seconds) || !std::isfinite(dt) || !(dt > 0.0)) {
+    throw std::invalid_argument("frames_in: needs a number of seconds and a finite dt > 0 (got seconds " +
+                                std::to_string(seconds) + ", dt " + std::to_string(dt) + ")");
+  }
+  // Rounded as a double and clamped before the cast: a cast out of int's range is undefined.
+  const double frames = std::round(seconds / dt);
+  if (!(frames >= 1.0)) return 1;
+  if (frames >= static_cast<double>(INT_MAX)) return INT_MAX;
+  return static_cast<int>(frames);
 }
 
 }  // namespace cl

@@ -47,4 +47,16 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
 // Every scene name shipped in a scenes directory, sorted.
 std::vector<std::string> list_scene_names(const std::string& scene_dir);
 
+// One line for a driver's header: "name (N particles, M springs)", with
+// ", K triangles" before the ")" when the scene has triangles. A scene without
+// springs says "0 springs"; an empty name leaves the text to start with " (".
+std::string describe(const Scene& scene);
+
+// The steps of dt (s) that make up `seconds` (s), rounded to the nearest and at
+// least 1: a window or a mark of `seconds` in a run of frames. Half a step
+// rounds away from zero; seconds <= dt/2 (0 and negative included) gives 1, and
+// a count past INT_MAX gives INT_MAX. Throws std::invalid_argument for a NaN
+// `seconds` or a dt that is not a finite number > 0.
+int frames_in(double seconds, double dt);
+
 }  // namespace cl

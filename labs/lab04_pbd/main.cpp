@@ -4,10 +4,8 @@
 //   --sweep-iterations 1,2,...,128          steady strain against K  -> strain_vs_iterations.csv
 //   --sweep-substeps 1,2,...,64 --cost C    substeps × K = C fixed   -> substeps.csv
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <exception>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -49,19 +47,6 @@ cl::lab04::PbdSettings frame_settings(const cl::Scene& scene, const cl::CommonOp
   return settings;
 }
 
-// Seconds of the scene's frames, at least one frame.
-int frames_in(double seconds, const cl::Scene& scene) {
-  return std::max(1, static_cast<int>(std::lround(seconds / scene.dt)));
-}
-
-std::string describe(const cl::Scene& scene) {
-  std::ostringstream text;
-  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
-  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
-  text << ")";
-  return text.str();
-}
-
 std::string frame_file(int frame) {
   char name[32];
   std::snprintf(name, sizeof name, "frame_%06d.obj", frame);
@@ -80,7 +65,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::lab04::PbdSettings settings = frame_settings(scene, options, lab, options.iterations);
   cl::lab04::RunPlan plan;
   plan.frames = scene.steps;
-  plan.window_frames = frames_in(lab.window_seconds, scene);
+  plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
   cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "kinetic", "potential", "total_energy",
@@ -110,7 +95,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const bool diverged = !result.problem.empty();
 
   std::printf("%s: scene %s, %s, K = %d, %d substep(s) of %.4g s per %.4g s frame, %d frames\n", kLab,
-              describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps,
+              cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps,
               scene.dt / lab.substeps, scene.dt, scene.steps);
   if (diverged) {
     std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
@@ -228,9 +213,9 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
       cl::Particles particles = scene.particles;
       cl::lab04::RunPlan plan;
       plan.frames = scene.steps;
-      plan.window_frames = frames_in(lab.window_seconds, scene);
+      plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
       plan.settle_tolerance = lab.settle_tolerance;
-      plan.energy_frame = frames_in(lab.energy_seconds, scene);
+      plan.energy_frame = cl::frames_in(lab.energy_seconds, scene.dt);
       run.result = cl::lab04::run_frames(particles, constraints[run.scene],
                                          frame_settings(scene, options, lab, run.iterations), run.substeps, plan);
     } catch (...) {
@@ -255,12 +240,12 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
     const cl::lab04::RunResult& result = run.result;
     const bool ok = result.problem.empty();
     const bool measured = ok && result.windows_done > 0;
-    const bool energy_known = ok && result.frames_done >= frames_in(lab.energy_seconds, scene);
+    const bool energy_known = ok && result.frames_done >= cl::frames_in(lab.energy_seconds, scene.dt);
     auto value = [](bool known, double number) -> cl::CsvCell {
       return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
     };
-    const double window_seconds = frames_in(lab.window_seconds, scene) * scene.dt;
-    const double energy_seconds = frames_in(lab.energy_seconds, scene) * scene.dt;
+    const double window_seconds = cl::frames_in(lab.window_seconds, scene.dt) * scene.dt;
+    const double energy_seconds = cl::frames_in(lab.energy_seconds, scene.dt) * scene.dt;
     table.add_row({scene.name, static_cast<long long>(scene.grid_nx), static_cast<long long>(scene.grid_ny),
                    static_cast<long long>(scene.particles.size()), static_cast<long long>(scene.springs.size()),
                    options.method, scene.dt, static_cast<long long>(run.substeps),

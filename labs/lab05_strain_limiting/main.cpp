@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -54,14 +53,6 @@ Limit limit_from(const std::string& name) {
   } catch (const std::invalid_argument& error) {
     throw cl::InputError(std::string("--limit: ") + error.what());
   }
-}
-
-std::string describe(const cl::Scene& scene) {
-  std::ostringstream text;
-  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
-  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
-  text << ")";
-  return text.str();
 }
 
 std::string status_of(const cl::lab05::RunResult& result) {
@@ -128,7 +119,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const double elastic = cl::lab05::elastic_energy(particles.x, system.springs);
 
   std::printf("%s: scene %s, limit %s, band [%.4g, %.4g], K = %d, dt = %.4g s, %d steps\n", kLab,
-              describe(scene).c_str(), cl::lab05::limit_name(limit), lab.sigma_min, lab.sigma_max,
+              cl::describe(scene).c_str(), cl::lab05::limit_name(limit), lab.sigma_min, lab.sigma_max,
               options.iterations, scene.dt, scene.steps);
   if (diverged) {
     std::printf("  UNSTABLE at step %d (t = %.4g s): %s\n", result.problem_step, result.problem_step * scene.dt,
@@ -197,7 +188,7 @@ int compare_limits(const cl::CommonOptions& options, const LabOptions& lab) {
                       "max_strain_over_run", "min_strain_over_run", "final_max_strain", "final_min_strain",
                       "seconds", "seconds_per_step", "status"});
   cl::CsvTable shapes({"limit", "spring", "x_i", "y_i", "z_i", "x_j", "y_j", "z_j", "strain"});
-  std::printf("%s: scene %s, band [%.4g, %.4g], K = %d, dt = %.4g s, %d steps\n", kLab, describe(scene).c_str(),
+  std::printf("%s: scene %s, band [%.4g, %.4g], K = %d, dt = %.4g s, %d steps\n", kLab, cl::describe(scene).c_str(),
               lab.sigma_min, lab.sigma_max, options.iterations, scene.dt, scene.steps);
   std::printf("%-18s %14s %14s %14s %12s  %s\n", "limit", "max strain", "min strain", "final max", "s/step",
               "status");
@@ -281,7 +272,7 @@ int stability_map(const cl::CommonOptions& options, const LabOptions& lab) {
       MapCell cell;
       cell.stiffness = stiffness;
       cell.dt = dt;
-      cell.steps = std::max(1, static_cast<int>(std::lround(lab.map_seconds / dt)));
+      cell.steps = cl::frames_in(lab.map_seconds, dt);
       cells.push_back(cell);
     }
   }
@@ -329,7 +320,7 @@ int stability_map(const cl::CommonOptions& options, const LabOptions& lab) {
                       "limited_steps_done", "limited_max_strain", "limited_min_strain", "limited_max_energy_rise",
                       "limited_status", "why", "seconds"});
   std::printf("%s: scene %s, limit %s, band [%.4g, %.4g], K = %d, %.3g s per cell\n", kLab,
-              describe(scene).c_str(), cl::lab05::limit_name(limit), lab.sigma_min, lab.sigma_max,
+              cl::describe(scene).c_str(), cl::lab05::limit_name(limit), lab.sigma_min, lab.sigma_max,
               options.iterations, lab.map_seconds);
   std::printf("%10s %10s %7s  %-24s %14s  %s\n", "k (N/m)", "dt (s)", "steps", "verdict", "limited max", "why");
   int stable = 0, bounded = 0, blew_up = 0, band_lost = 0;

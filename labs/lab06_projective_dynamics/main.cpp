@@ -67,7 +67,8 @@ cl::lab06::Problem problem_of(const cl::Scene& scene) {
   return cl::lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
 }
 
-std::string describe(const cl::Scene& scene) {
+// cl::describe without the triangles: this lab's objective has springs alone.
+std::string describe_springs(const cl::Scene& scene) {
   std::ostringstream text;
   text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs)";
   return text.str();
@@ -101,7 +102,7 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const bool diverged = !result.problem.empty();
 
-  std::printf("%s: scene %s, %s, K = %d%s, %d steps of %.4g s\n", kLab, describe(scene).c_str(),
+  std::printf("%s: scene %s, %s, K = %d%s, %d steps of %.4g s\n", kLab, describe_springs(scene).c_str(),
               cl::lab06::method_name(method), options.iterations,
               lab.tolerance > 0.0 ? (", tolerance " + cl::format_double(lab.tolerance)).c_str() : "", scene.steps,
               scene.dt);

@@ -34,7 +34,7 @@ struct LabOptions {
   std::vector<int> compare_substeps;
 };
 
-std::string describe(const cl::Scene& scene) {
+std::string describe_constraints(const cl::Scene& scene) {
   std::ostringstream text;
   int hard = 0;
   for (const cl::Spring& s : scene.springs) hard += std::isfinite(s.stiffness) ? 0 : 1;
@@ -183,8 +183,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const bool stopped = !outcome.empty();
   const double final_error = cl::lab07::max_constraint_error(particles.x, scene.springs);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
-  std::printf("%s: scene %s, %s, dt %.4g s, %d steps%s%s\n", kLab, describe(scene).c_str(), options.method.c_str(),
-              scene.dt, scene.steps, lab.stabilize ? ", stabilized" : "",
+  std::printf("%s: scene %s, %s, dt %.4g s, %d steps%s%s\n", kLab, describe_constraints(scene).c_str(),
+              options.method.c_str(), scene.dt, scene.steps, lab.stabilize ? ", stabilized" : "",
               compliance_block ? "" : ", no compliance block (every constraint hard)");
   if (redundant) {
     std::printf("  the hard constraints are redundant at the start (J W J^T singular): lambda is not unique%s\n",
@@ -371,7 +371,7 @@ int run_compare(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::CsvTable table({"scene", "method", "dt", "substeps", "iterations", "frames", "median_ms_per_frame", "mean_max_strain",
                       "worst_max_strain", "status"});
   std::printf("%s: scene %s, %d frames of %.4g s; strain = max over springs of |phi|/L after each frame\n", kLab,
-              describe(scene).c_str(), scene.steps, scene.dt);
+              describe_constraints(scene).c_str(), scene.steps, scene.dt);
   std::printf("%-17s %8s %10s %12s %15s %15s  %s\n", "method", "substeps", "iterations", "median ms/frame", "mean max strain",
               "worst", "status");
   for (const CompareRow& row : rows) {

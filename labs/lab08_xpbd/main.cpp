@@ -7,7 +7,6 @@
 #include <cstdio>
 #include <exception>
 #include <optional>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -42,19 +41,6 @@ cl::lab08::FrameSettings frame_settings(const cl::Scene& scene, const cl::Common
   return settings;
 }
 
-// Seconds of the scene's frames, at least one frame.
-int frames_in(double seconds, const cl::Scene& scene) {
-  return std::max(1, static_cast<int>(std::lround(seconds / scene.dt)));
-}
-
-std::string describe(const cl::Scene& scene) {
-  std::ostringstream text;
-  text << scene.name << " (" << scene.particles.size() << " particles, " << scene.springs.size() << " springs";
-  if (!scene.triangles.empty()) text << ", " << scene.triangles.size() << " triangles";
-  text << ")";
-  return text.str();
-}
-
 // The multipliers in newtons: λ / Δt² with Δt the substep (λ is force × Δt²).
 std::vector<double> multipliers_in_newtons(const Eigen::VectorXd& lambda, double substep) {
   std::vector<double> forces(static_cast<std::size_t>(lambda.size()));
@@ -73,7 +59,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
   cl::lab08::RunPlan plan;
   plan.frames = scene.steps;
-  plan.window_frames = frames_in(lab.window_seconds, scene);
+  plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
   cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "total_stretch", "kinetic", "potential",
@@ -99,7 +85,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const std::vector<double> forces = multipliers_in_newtons(result.lambda, substep);
 
   std::printf("%s: scene %s, %s, K = %d, %d substep(s) of %.4g s per %.4g s frame, %d frames\n", kLab,
-              describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps, substep, scene.dt,
+              cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps, substep, scene.dt,
               scene.steps);
   if (diverged) {
     std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
@@ -204,7 +190,7 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
       cl::Particles particles = scene.particles;
       cl::lab08::RunPlan plan;
       plan.frames = scene.steps;
-      plan.window_frames = frames_in(lab.window_seconds, scene);
+      plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
       plan.settle_tolerance = lab.settle_tolerance;
       results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
     } catch (...) {
@@ -219,7 +205,7 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
                       "window_spread", "max_energy_rise", "seconds", "status"});
   std::printf("%s: %s on %s; each run until the mean total stretch of three %.3g s windows agrees to %.3g "
               "(at most %d frames)\n",
-              kLab, options.method.c_str(), describe(scene).c_str(), lab.window_seconds, lab.settle_tolerance,
+              kLab, options.method.c_str(), cl::describe(scene).c_str(), lab.window_seconds, lab.settle_tolerance,
               scene.steps);
   if (hanging) std::printf("  hanging at rest with its springs' stiffness: total stretch %.6e m\n", *hanging);
   std::printf("%10s %14s %12s %10s %8s %8s  %s\n", "iterations", "steady_stretch", "k_eff/k", "max_strain",
@@ -236,7 +222,7 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
     const double ratio = ratio_known ? *hanging / result.window_total_stretch : 0.0;
     table.add_row({scene.name, options.method, scene.dt, static_cast<long long>(lab.substeps),
                    static_cast<long long>(ks[r]), static_cast<long long>(result.frames_done),
-                   result.frames_done * scene.dt, frames_in(lab.window_seconds, scene) * scene.dt,
+                   result.frames_done * scene.dt, cl::frames_in(lab.window_seconds, scene.dt) * scene.dt,
                    value(measured, result.window_total_stretch), value(hanging.has_value(), hanging.value_or(0.0)),
                    value(ratio_known, ratio), value(measured, result.window_max_strain),
                    value(measured && result.window_spread >= 0.0, result.window_spread), result.max_energy_rise,

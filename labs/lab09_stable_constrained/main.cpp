@@ -50,7 +50,7 @@ constexpr double kKick = 0.01;       // m/s
 // A sweep run is unstable once a link turns this many times faster than the kick.
 constexpr double kTransverseGrowth = 100.0;
 
-std::string describe(const cl::Scene& scene) {
+std::string describe_constraints_and_masses(const cl::Scene& scene) {
   std::ostringstream text;
   int hard = 0;
   for (const cl::Spring& s : scene.springs) hard += std::isfinite(s.stiffness) ? 0 : 1;
@@ -162,7 +162,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const double final_transverse = cl::lab09::max_transverse_speed(particles, scene.springs);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   std::printf("%s: scene %s, %s, geometric stiffness %s (compression: %s), dt %.4g s, %d steps\n", kLab,
-              describe(scene).c_str(), options.method.c_str(), lab.geometric_stiffness.c_str(),
+              describe_constraints_and_masses(scene).c_str(), options.method.c_str(), lab.geometric_stiffness.c_str(),
               lab.compression.c_str(), scene.dt, scene.steps);
   if (stopped) {
     std::printf("  STOPPED at step %d (t = %.4g s): %s\n", problem_frame, problem_frame * scene.dt, outcome.c_str());

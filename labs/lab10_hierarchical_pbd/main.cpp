@@ -39,7 +39,7 @@ struct LabOptions {
   double max_projections = 0.0;  // 0: no limit beyond max_sweeps
 };
 
-std::string describe(const cl::Scene& scene) {
+std::string describe_cloth(const cl::Scene& scene) {
   std::ostringstream text;
   text << scene.name << " (" << scene.grid_nx << " x " << scene.grid_ny << " cloth, " << scene.particles.size()
        << " particles, " << scene.springs.size() << " springs)";
@@ -118,7 +118,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const bool diverged = !result.problem.empty();
 
   std::printf("%s: scene %s, %d level(s), sweeps per level %s (the cloth first), %d frames of %.4g s\n", kLab,
-              describe(scene).c_str(), lab.levels, join(settings.iterations).c_str(), scene.steps, scene.dt);
+              describe_cloth(scene).c_str(), lab.levels, join(settings.iterations).c_str(), scene.steps, scene.dt);
   for (int l = 1; l < hierarchy.level_count(); ++l) {
     const cl::HierarchyLevel& level = hierarchy.levels[static_cast<std::size_t>(l)];
     std::printf("  level %d: %d x %d particles, %zu unilateral constraints\n", l, level.nx, level.ny,
