@@ -33,4 +33,45 @@ void write_summary(const std::string& path, const RunSummary& summary) {
   write_file_atomic(path, to_json(summary).dump(1) + "\n");
 }
 
+RunSummary stepping_summary(const std::string& lab, const std::string& method, const Scene& scene,
+                            const Particles& state, const StrainStats& strain, double seconds) {
+  RunSummary summary;
+  summary.lab = lab;
+  summary.method = method;
+  summary.scene = scene.name;
+  summary.dt = scene.dt;
+  summary.steps = scene.steps;
+  summary.positions = state.x;
+  summary.velocities = state.v;
+  summary.max_strain_error = strain.max;
+  summary.seconds = seconds;
+  return summary;
+}
+
+void add_energies(RunSummary& summary, double kinetic, double potential, std::optional<double> elastic,
+                  double total_start) {
+  summary.extra["kinetic_energy"] = kinetic;
+  summary.extra["potential_energy"] = potential;
+  double total = kinetic + potential;
+  if (elastic) {
+    summary.extra["elastic_energy"] = *elastic;
+    total += *elastic;
+  }
+  add_total_energy(summary, total, total_start);
+}
+
+void add_total_energy(RunSummary& summary, double total, double total_start) {
+  summary.extra["total_energy"] = total;
+  summary.extra["total_energy_start"] = total_start;
+}
+
+void add_divergence(RunSummary& summary, const std::string& problem, const std::string& at_key, int at) {
+  const bool diverged = !problem.empty();
+  summary.extra["diverged"] = diverged;
+  if (diverged) {
+    summary.extra[at_key] = at;
+    summary.extra["problem"] = problem;
+  }
+}
+
 }  // namespace cl

@@ -6,6 +6,10 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include "common/metrics.h"
+#include "common/particles.h"
+#include "common/scene.h"
+
 namespace cl {
 
 struct RunSummary {
@@ -28,5 +32,30 @@ nlohmann::ordered_json to_json(const RunSummary& summary);
 
 // Writes the summary atomically. Throws InputError when the path is not writable.
 void write_summary(const std::string& path, const RunSummary& summary);
+
+// The fields every time-stepping run fills alike: lab, method, scene (its
+// name), dt (s) and steps (the scene's, after --dt and --steps, also for a run
+// that stopped early), positions and velocities (`state`, the final one),
+// max_strain_error (strain.max) and seconds (wall time of the simulation, s).
+// iterations is left unset and extra empty: the lab adds its own.
+RunSummary stepping_summary(const std::string& lab, const std::string& method, const Scene& scene,
+                            const Particles& state, const StrainStats& strain, double seconds);
+
+// Appends the energies at the end of the run and its start, J, in this order:
+//     kinetic_energy, potential_energy, elastic_energy (only when given),
+//     total_energy (their sum: kinetic + potential + elastic), total_energy_start.
+// A key the lab has set already keeps its place and takes the new value.
+void add_energies(RunSummary& summary, double kinetic, double potential, std::optional<double> elastic,
+                  double total_start);
+
+// Appends total_energy and total_energy_start (J), for a lab that measures the
+// total alone.
+void add_total_energy(RunSummary& summary, double total, double total_start);
+
+// Appends the verdict of a run that stops at its first problem: diverged
+// (`problem` is not empty) and, only when it diverged, `at_key` (the lab's
+// name for where: "diverged_at_frame" or "diverged_at_step") = at, then problem.
+// An empty problem writes diverged = false alone and ignores at_key and at.
+void add_divergence(RunSummary& summary, const std::string& problem, const std::string& at_key, int at);
 
 }  // namespace cl

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <exception>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -123,17 +124,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = options.method;
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
+    cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = strain.max;
-    summary.seconds = result.seconds;
     summary.extra["substeps"] = lab.substeps;
     if (settings.projection == cl::lab04::Projection::kJacobi) summary.extra["omega"] = lab.omega;
     summary.extra["rms_strain_error"] = strain.rms;
@@ -142,15 +134,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       summary.extra["window_max_strain_error"] = result.window_max_strain;
       summary.extra["window_rms_strain_error"] = result.window_rms_strain;
     }
-    summary.extra["kinetic_energy"] = kinetic;
-    summary.extra["potential_energy"] = potential;
-    summary.extra["total_energy"] = kinetic + potential;
-    summary.extra["total_energy_start"] = result.energy_start;
-    summary.extra["diverged"] = diverged;
-    if (diverged) {
-      summary.extra["diverged_at_frame"] = result.problem_frame;
-      summary.extra["problem"] = result.problem;
-    }
+    cl::add_energies(summary, kinetic, potential, std::nullopt, result.energy_start);
+    cl::add_divergence(summary, result.problem, "diverged_at_frame", result.problem_frame);
     cl::write_summary(options.summary, summary);
   }
   return 0;

@@ -136,17 +136,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_step.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = cl::lab05::limit_name(limit);
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
+    cl::RunSummary summary =
+        cl::stepping_summary(kLab, cl::lab05::limit_name(limit), scene, particles, error, result.seconds);
     summary.iterations = options.iterations;
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = error.max;
-    summary.seconds = result.seconds;
     summary.extra["limit"] = cl::lab05::limit_name(limit);
     summary.extra["sigma_min"] = lab.sigma_min;
     summary.extra["sigma_max"] = lab.sigma_max;
@@ -156,17 +148,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["min_strain_over_run"] = result.min_strain;
     summary.extra["rms_strain_error"] = error.rms;
     summary.extra["seconds_per_step"] = per_step(result);
-    summary.extra["kinetic_energy"] = kinetic;
-    summary.extra["potential_energy"] = potential;
-    summary.extra["elastic_energy"] = elastic;
-    summary.extra["total_energy"] = kinetic + potential + elastic;
-    summary.extra["total_energy_start"] = result.energy_start;
+    cl::add_energies(summary, kinetic, potential, elastic, result.energy_start);
     if (limit == Limit::kSprings) summary.extra["band_held"] = outside.empty() && !diverged;
-    summary.extra["diverged"] = diverged;
-    if (diverged) {
-      summary.extra["diverged_at_step"] = result.problem_step;
-      summary.extra["problem"] = result.problem;
-    }
+    cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
     cl::write_summary(options.summary, summary);
   }
   return 0;

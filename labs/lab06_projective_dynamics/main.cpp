@@ -128,17 +128,9 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_step.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = cl::lab06::method_name(method);
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
+    cl::RunSummary summary =
+        cl::stepping_summary(kLab, cl::lab06::method_name(method), scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = strain.max;
-    summary.seconds = result.seconds;
     summary.extra["objective"] = result.objective;
     summary.extra["factorizations"] = solver.factorizations();
     summary.extra["iterations_done"] = result.iterations_done;
@@ -146,13 +138,8 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["factor_seconds"] = solver.factor_seconds();
     summary.extra["failed_decreases"] = result.failed_decreases;
     summary.extra["rms_strain_error"] = strain.rms;
-    summary.extra["total_energy"] = result.energy_end;
-    summary.extra["total_energy_start"] = result.energy_start;
-    summary.extra["diverged"] = diverged;
-    if (diverged) {
-      summary.extra["diverged_at_step"] = result.problem_step;
-      summary.extra["problem"] = result.problem;
-    }
+    cl::add_total_energy(summary, result.energy_end, result.energy_start);
+    cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
     cl::write_summary(options.summary, summary);
   }
   return 0;

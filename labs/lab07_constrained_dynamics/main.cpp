@@ -220,16 +220,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = options.method;
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = strain.max;
-    summary.seconds = step_seconds + stabilize_seconds;
+    cl::RunSummary summary =
+        cl::stepping_summary(kLab, options.method, scene, particles, strain, step_seconds + stabilize_seconds);
     summary.extra["multipliers"] = std::vector<double>(lambda.data(), lambda.data() + lambda.size());
     summary.extra["max_constraint_error"] = final_error;
     summary.extra["worst_constraint_error"] = worst_error;
@@ -243,8 +235,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["compliance_block"] = compliance_block;
     summary.extra["steps_done"] = frames_done;
     summary.extra["step_seconds"] = step_seconds;
-    summary.extra["total_energy"] = total_energy(particles, scene, lambda);
-    summary.extra["total_energy_start"] = energy_start;
+    cl::add_total_energy(summary, total_energy(particles, scene, lambda), energy_start);
     summary.extra["diverged"] = outcome.rfind("diverged", 0) == 0;
     summary.extra["singular"] = outcome.rfind("singular", 0) == 0;
     if (stopped) {

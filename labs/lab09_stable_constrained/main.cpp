@@ -184,16 +184,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = options.method;
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = strain.max;
-    summary.seconds = seconds;
+    cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, seconds);
     summary.extra["geometric_stiffness"] = lab.geometric_stiffness;
     summary.extra["compression"] = lab.compression;
     summary.extra["multipliers"] = std::vector<double>(lambda.data(), lambda.data() + lambda.size());
@@ -202,8 +193,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["final_transverse_speed"] = final_transverse;
     summary.extra["regularization"] = lab.regularize;
     summary.extra["steps_done"] = frames_done;
-    summary.extra["total_energy"] = total_energy(particles, scene);
-    summary.extra["total_energy_start"] = energy_start;
+    cl::add_total_energy(summary, total_energy(particles, scene), energy_start);
     summary.extra["diverged"] = outcome.rfind("diverged", 0) == 0;
     summary.extra["failed"] = outcome.rfind("failed", 0) == 0;
     if (stopped) {

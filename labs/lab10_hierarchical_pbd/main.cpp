@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -45,6 +46,9 @@ std::string describe_cloth(const cl::Scene& scene) {
        << " particles, " << scene.springs.size() << " springs)";
   return text.str();
 }
+
+// The summary's method: one level is plain Gauss-Seidel PBD.
+const char* method_name(int levels) { return levels == 1 ? "gauss-seidel" : "hierarchical"; }
 
 std::string join(const std::vector<int>& values, const char* separator = ",") {
   std::string text;
@@ -141,30 +145,15 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary;
-    summary.lab = kLab;
-    summary.method = lab.levels == 1 ? "gauss-seidel" : "hierarchical";
-    summary.scene = scene.name;
-    summary.dt = scene.dt;
-    summary.steps = scene.steps;
+    cl::RunSummary summary =
+        cl::stepping_summary(kLab, method_name(lab.levels), scene, particles, strain, result.seconds);
     summary.iterations = settings.iterations.front();
-    summary.positions = particles.x;
-    summary.velocities = particles.v;
-    summary.max_strain_error = strain.max;
-    summary.seconds = result.seconds;
     summary.extra["levels"] = lab.levels;
     summary.extra["iterations_per_level"] = settings.iterations;
     summary.extra["projections"] = result.projections;
     summary.extra["rms_strain_error"] = strain.rms;
-    summary.extra["kinetic_energy"] = kinetic;
-    summary.extra["potential_energy"] = potential;
-    summary.extra["total_energy"] = kinetic + potential;
-    summary.extra["total_energy_start"] = result.energy_start;
-    summary.extra["diverged"] = diverged;
-    if (diverged) {
-      summary.extra["diverged_at_frame"] = result.problem_frame;
-      summary.extra["problem"] = result.problem;
-    }
+    cl::add_energies(summary, kinetic, potential, std::nullopt, result.energy_start);
+    cl::add_divergence(summary, result.problem, "diverged_at_frame", result.problem_frame);
     cl::write_summary(options.summary, summary);
   }
   return 0;
@@ -249,7 +238,7 @@ int run_converge(const cl::CommonOptions& options, const LabOptions& lab) {
         const cl::lab10::ConvergenceSample& last = result.samples.back();
         cl::RunSummary summary;
         summary.lab = kLab;
-        summary.method = levels == 1 ? "gauss-seidel" : "hierarchical";
+        summary.method = method_name(levels);
         summary.scene = scene.name;
         summary.dt = scene.dt;
         summary.steps = 1;

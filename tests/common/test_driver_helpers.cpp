@@ -1,17 +1,38 @@
-// The pieces the lab drivers share: describe and frames_in (common/scene.h).
+// The pieces the lab drivers share: describe and frames_in (common/scene.h),
+// the time-stepping summary and its energy and verdict fields
+// (common/summary.h).
 #include <climits>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include "common/scene.h"
+#include "common/summary.h"
+
+using Catch::Matchers::WithinRel;
 
 namespace {
 
 cl::Scene parse(const std::string& text) { return cl::parse_scene(text, "test.json"); }
+
+std::vector<std::string> keys_of(const nlohmann::ordered_json& object) {
+  std::vector<std::string> keys;
+  for (const auto& item : object.items()) keys.push_back(item.key());
+  return keys;
+}
+
+// A moving two-particle scene and a summary of it, as a driver fills one.
+cl::Scene two_particles() {
+  return parse(R"({"name": "pair", "dt": 0.01, "steps": 7,
+                   "particles": [{"x": [0, 0, 0], "v": [1, 2, 3]}, {"x": [1, 0, 0], "v": [4, 5, 6]}],
+                   "springs": [{"i": 0, "j": 1}]})");
+}
 
 }  // namespace
 
@@ -70,5 +91,76 @@ TEST_CASE("frames_in refuses a NaN time and a dt that is not finite and positive
   for (const double dt : {0.0, -0.01, nan, inf}) {
     CAPTURE(dt);
     CHECK_THROWS_AS(cl::frames_in(1.0, dt), std::invalid_argument);
+  }
+}
+
+TEST_CASE("stepping_summary fills the contract's common fields in their order", "[common]") {
+  const cl::Scene scene = two_particles();
+  cl::Particles state = scene.particles;
+  state.x(1, 0) = 0.5;  // a final state that is not the scene's start
+  cl::StrainStats strain;
+  strain.max = 0.125;
+  strain.rms = 0.0625;
+  cl::RunSummary summary = cl::stepping_summary("labXX", "some-method", scene, state, strain, 2.5);
+  CHECK_FALSE(summary.iterations);
+  CHECK(summary.extra.empty());
+
+  nlohmann::ordered_json json = cl::to_json(summary);
+  CHECK(keys_of(json) == std::vector<std::string>{"lab", "method", "scene", "dt", "steps", "positions", "velocities",
+                                                  "max_strain_error", "seconds"});
+  CHECK(json["lab"] == "labXX");
+  CHECK(json["method"] == "some-method");
+  CHECK(json["scene"] == "pair");
+  CHECK(json["dt"].get<double>() == scene.dt);
+  CHECK(json["steps"] == 7);
+  CHECK(json["positions"][0][1].get<double>() == 0.5);
+  CHECK(json["positions"][1][0].get<double>() == 1.0);
+  CHECK(json["velocities"][1][2].get<double>() == 6.0);
+  CHECK(json["max_strain_error"].get<double>() == 0.125);
+  CHECK(json["seconds"].get<double>() == 2.5);
+
+  summary.iterations = 12;  // a lab that iterates: after steps, as the contract orders it
+  json = cl::to_json(summary);
+  CHECK(keys_of(json) == std::vector<std::string>{"lab", "method", "scene", "dt", "steps", "iterations",
+                                                  "positions", "velocities", "max_strain_error", "seconds"});
+}
+
+TEST_CASE("add_energies appends the energies in order, elastic only when given", "[common]") {
+  const double kinetic = 0.75, potential = -3.5, elastic = 0.125, start = -2.0;
+  cl::RunSummary summary;
+  summary.extra["own"] = 1;
+  cl::add_energies(summary, kinetic, potential, std::nullopt, start);
+  CHECK(keys_of(summary.extra) ==
+        std::vector<std::string>{"own", "kinetic_energy", "potential_energy", "total_energy", "total_energy_start"});
+  CHECK(summary.extra["total_energy"].get<double>() == kinetic + potential);
+  CHECK(summary.extra["total_energy_start"].get<double>() == start);
+
+  cl::RunSummary with_elastic;
+  cl::add_energies(with_elastic, kinetic, potential, elastic, start);
+  CHECK(keys_of(with_elastic.extra) == std::vector<std::string>{"kinetic_energy", "potential_energy", "elastic_energy",
+                                                                "total_energy", "total_energy_start"});
+  CHECK_THAT(with_elastic.extra["total_energy"].get<double>(), WithinRel(kinetic + potential + elastic, 1e-15));
+  CHECK(with_elastic.extra["elastic_energy"].get<double>() == elastic);
+
+  cl::RunSummary total_only;
+  cl::add_total_energy(total_only, 1.5, 2.5);
+  CHECK(keys_of(total_only.extra) == std::vector<std::string>{"total_energy", "total_energy_start"});
+  CHECK(total_only.extra["total_energy"].get<double>() == 1.5);
+}
+
+TEST_CASE("add_divergence writes diverged and, only when it did, where and why", "[common]") {
+  cl::RunSummary fine;
+  cl::add_divergence(fine, "", "diverged_at_frame", 17);
+  CHECK(keys_of(fine.extra) == std::vector<std::string>{"diverged"});
+  CHECK(fine.extra["diverged"] == false);
+
+  for (const std::string at_key : {"diverged_at_frame", "diverged_at_step"}) {
+    CAPTURE(at_key);
+    cl::RunSummary bad;
+    cl::add_divergence(bad, "positions are not finite", at_key, 17);
+    CHECK(keys_of(bad.extra) == std::vector<std::string>{"diverged", at_key, "problem"});
+    CHECK(bad.extra["diverged"] == true);
+    CHECK(bad.extra[at_key] == 17);
+    CHECK(bad.extra["problem"] == "positions are not finite");
   }
 }
