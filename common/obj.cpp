@@ -1,5 +1,6 @@
 #include "common/obj.h"
 
+#include <cstdio>
 #include <sstream>
 
 #include "common/output.h"
@@ -20,6 +21,15 @@ std::string obj_text(const Eigen::Matrix3Xd& x, const std::vector<Triangle>& tri
     for (const Spring& s : springs) text << "l " << s.i + 1 << ' ' << s.j + 1 << '\n';
   }
   return text.str();
+}
+
+void write_frame_obj(const std::string& dir, const std::string& lab, const Scene& scene, const Eigen::Matrix3Xd& x,
+                     int frame, double time) {
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.obj", frame);
+  const std::string comment =
+      lab + " scene " + scene.name + " frame " + std::to_string(frame) + " time " + format_double(time);
+  write_file_atomic(join_path(dir, name), obj_text(x, scene.triangles, scene.springs, comment));
 }
 
 }  // namespace cl

@@ -48,12 +48,6 @@ cl::lab04::PbdSettings frame_settings(const cl::Scene& scene, const cl::CommonOp
   return settings;
 }
 
-std::string frame_file(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.obj", frame);
-  return name;
-}
-
 // ------------------------------------------------------------------ one run
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
@@ -79,10 +73,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                    problem.empty() ? std::string("ok") : "diverged: " + problem});
     const bool last = record.frame == scene.steps;
     if (lab.frames_every > 0 && problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
-      cl::write_file_atomic(cl::join_path(frames_dir, frame_file(record.frame)),
-                            cl::obj_text(state.x, scene.triangles, scene.springs,
-                                         std::string(kLab) + " scene " + scene.name + " frame " +
-                                             std::to_string(record.frame) + " time " + cl::format_double(record.time)));
+      cl::write_frame_obj(frames_dir, kLab, scene, state.x, record.frame, record.time);
       ++frames_written;
     }
   };

@@ -78,12 +78,6 @@ std::vector<int> per_level(const LabOptions& lab, int levels) {
                        "), got " + std::to_string(given.size()));
 }
 
-std::string frame_file(int frame) {
-  char name[32];
-  std::snprintf(name, sizeof name, "frame_%06d.obj", frame);
-  return name;
-}
-
 // ------------------------------------------------------------------ one run
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
@@ -106,10 +100,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                    record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
     const bool last = record.frame == scene.steps;
     if (lab.frames_every > 0 && record.problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
-      cl::write_file_atomic(cl::join_path(frames_dir, frame_file(record.frame)),
-                            cl::obj_text(state.x, scene.triangles, scene.springs,
-                                         std::string(kLab) + " scene " + scene.name + " frame " +
-                                             std::to_string(record.frame) + " time " + cl::format_double(record.time)));
+      cl::write_frame_obj(frames_dir, kLab, scene, state.x, record.frame, record.time);
       ++frames_written;
     }
   };

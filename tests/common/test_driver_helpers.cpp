@@ -1,8 +1,10 @@
 // The pieces the lab drivers share: describe and frames_in (common/scene.h),
 // the time-stepping summary and its energy and verdict fields
-// (common/summary.h).
+// (common/summary.h), the OBJ frame file (common/obj.h).
 #include <climits>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -12,6 +14,8 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/obj.h"
+#include "common/output.h"
 #include "common/scene.h"
 #include "common/summary.h"
 
@@ -163,4 +167,24 @@ TEST_CASE("add_divergence writes diverged and, only when it did, where and why",
     CHECK(bad.extra[at_key] == 17);
     CHECK(bad.extra["problem"] == "positions are not finite");
   }
+}
+
+TEST_CASE("an OBJ frame is named by its zero-padded number and says what it is", "[common]") {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "cl_test_obj_frame";
+  std::filesystem::remove_all(dir);
+  const cl::Scene scene = two_particles();
+  cl::write_frame_obj(dir.string(), "labXX", scene, scene.particles.x, 42, 0.5);
+  std::ifstream file(dir / "frame_000042.obj");
+  REQUIRE(file.good());
+  std::string first, line;
+  std::getline(file, first);
+  CHECK(first == "# labXX scene pair frame 42 time " + cl::format_double(0.5));
+  int vertices = 0, lines = 0;
+  while (std::getline(file, line)) {
+    vertices += line.rfind("v ", 0) == 0;
+    lines += line.rfind("l ", 0) == 0;
+  }
+  CHECK(vertices == 2);
+  CHECK(lines == 1);  // no triangles: the spring as a line
+  std::filesystem::remove_all(dir);
 }
