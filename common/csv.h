@@ -7,6 +7,8 @@
 namespace cl {
 
 // A cell: a number (written with 17 significant digits), an integer or text.
+// Text with a comma, a double quote or a line break is quoted as RFC 4180
+// says ("a, b" -> "\"a, b\"", a quote doubled), so any CSV reader splits it right.
 using CsvCell = std::variant<double, long long, std::string>;
 
 class CsvTable {

@@ -44,6 +44,15 @@ TEST_CASE("a CSV table is written whole into a new directory", "[common][output]
   std::filesystem::remove_all(dir);
 }
 
+TEST_CASE("CSV text with commas, quotes or line breaks is quoted as RFC 4180 says", "[common][output]") {
+  cl::CsvTable table({"why", "n"});
+  table.add_row({std::string("plain"), 1LL});
+  table.add_row({std::string("blew up at 0.5 s, strain 3"), 2LL});
+  table.add_row({std::string("said \"stop\""), 3LL});
+  table.add_row({std::string("two\nlines"), 4LL});
+  CHECK(table.text() == "why,n\nplain,1\n\"blew up at 0.5 s, strain 3\",2\n\"said \"\"stop\"\"\",3\n\"two\nlines\",4\n");
+}
+
 TEST_CASE("the run summary has the contract's keys and exact positions", "[common][output]") {
   const std::filesystem::path dir = fresh_dir("summary");
   cl::RunSummary summary;
