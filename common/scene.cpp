@@ -441,6 +441,13 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
   };
 
   bool open(bool array) {
+    // A scene nests 4 deep (top, particles, one particle, x). Deeper text is
+    // refused while it is read: printing or freeing a value nested a million
+    // deep recurses once per level and overflows the stack.
+    if (path_.size() >= kMaxNesting) {
+      throw InputError(source_ + ": " + here() + ": nested deeper than " + std::to_string(kMaxNesting) +
+                       " levels (a scene needs 4)");
+    }
     before_value();
     path_.push_back(Level{array, -1, {}, {}});
     return true;
@@ -470,6 +477,8 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
     }
     return field.empty() ? "(top level)" : field;
   }
+
+  static constexpr std::size_t kMaxNesting = 32;
 
   nlohmann::detail::json_sax_dom_parser<json> dom_;
   std::string source_;

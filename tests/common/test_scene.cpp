@@ -119,6 +119,16 @@ TEST_CASE("each rejection names the field and index", "[common][scene]") {
   CHECK_THAT(rejection(R"({"chain": {}, "cloth": {}})"), Contains("exactly one of"));
 }
 
+TEST_CASE("text nested a million deep is refused without a stack overflow", "[common][scene]") {
+  // The sanitizer job found that a 20,000-deep array overflowed the stack
+  // when the rejection printed it; a million deep crashed the Release build.
+  const std::size_t depth = 1'000'000;
+  const std::string text = std::string(depth, '[') + std::string(depth, ']');
+  CHECK_THAT(rejection(text), Contains("nested deeper than 32 levels"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0], "v": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}]})"),
+             Contains("particles[0].v"));
+}
+
 TEST_CASE("rest length 0 is allowed", "[common][scene]") {
   const cl::Scene scene = parse(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": 0}]})");
   CHECK(scene.springs[0].rest_length == 0.0);
