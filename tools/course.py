@@ -209,6 +209,15 @@ def student_warnings(lab, output):
     return found
 
 
+def sanitizer_env(leaks):
+    """The environment of a sanitizer run. allow_user_segv_handler=0: Catch2 may not
+    take SIGSEGV/SIGABRT from the sanitizer, whose report then shows the faulting
+    line, not a re-raise."""
+    return dict(os.environ,
+                ASAN_OPTIONS=f"detect_leaks={int(leaks)}:allow_user_segv_handler=0:handle_abort=1",
+                UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+
+
 def sanitizer_rerun(lab, case, log=sys.stdout):
     """Rerun one crashed case in NAME_tests_asan (cmake/AddLab.cmake: the tests and
     the student's code under -fsanitize=address,undefined -g -O1); lines saying
@@ -219,10 +228,8 @@ def sanitizer_rerun(lab, case, log=sys.stdout):
     except BuildFailure as failure:
         return ["the sanitizer build failed:", *failure.lines[:4]]
     binary = BIN / target
-    # allow_user_segv_handler=0: Catch2 may not take SIGSEGV/SIGABRT from the
-    # sanitizer, whose report then shows the faulting line, not a re-raise.
-    env = dict(os.environ, ASAN_OPTIONS="detect_leaks=0:allow_user_segv_handler=0:handle_abort=1",
-               UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+    # A crash is what is asked about here, so leaks are not reported.
+    env = sanitizer_env(leaks=False)
     with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
         try:
             done = subprocess.run([str(binary), case.name], cwd=work, env=env, capture_output=True,
@@ -1137,8 +1144,6 @@ def check_fuzz(checks, seconds=60):
 
 
 SANITIZE_BUILD = BUILD / "asan"
-SANITIZE_OPTIONS = {"ASAN_OPTIONS": "detect_leaks=1:abort_on_error=0:allow_user_segv_handler=0:handle_abort=1",
-                    "UBSAN_OPTIONS": "print_stacktrace=1:halt_on_error=1"}
 
 
 def sanitize_targets():
@@ -1158,7 +1163,7 @@ def run_sanitized(log=sys.stdout):
               "configure the sanitizer build")
     targets = sanitize_targets()
     build_targets(targets, build_dir=SANITIZE_BUILD, log=log, label="the test suite (-fsanitize=address,undefined)")
-    env = dict(os.environ, **SANITIZE_OPTIONS)
+    env = sanitizer_env(leaks=True)
     results = []
     for name in targets:
         start = time.monotonic()
