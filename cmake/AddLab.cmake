@@ -17,10 +17,11 @@
 # Targets:
 #   NAME_student                   the student's code (static library)
 #   NAME, NAME_tests               the executable and the graded tests, in build/bin.
-#                                  NAME links the student's code all the way down;
-#                                  NAME_tests links this lab's student code and, for
-#                                  each earlier lab, its reference when it has one,
-#                                  else the student's code (isolation, docs/DESIGN.md §4)
+#                                  Both link this lab's student code and, for each
+#                                  earlier lab, its reference when it has one, else
+#                                  the student's code (isolation, docs/DESIGN.md §4);
+#                                  NAME then says once on stderr which earlier labs
+#                                  run the student's code
 #   NAME_info                      the info program, linked like NAME_tests
 #   NAME_tests_asan                NAME_tests with the tests and the student's code
 #                                  under -fsanitize=address,undefined (not built by
@@ -116,13 +117,12 @@ function(add_lab name)
   endforeach()
 
   # Link lines: [support, implementation] for this lab, then for each earlier lab.
-  set(student_chain ${name}_support ${name}_student)
   set(reference_chain ${name}_support ${name}_reference)
   set(isolated_chain ${name}_support ${name}_student)
   set(links_json "")
+  set(student_earlier "")
   foreach(dep IN LISTS closure)
     get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
-    list(APPEND student_chain ${dep}_support ${dep}_student)
     list(APPEND reference_chain ${dep}_support ${dep}_reference)
     if(dep_has_reference)
       list(APPEND isolated_chain ${dep}_support ${dep}_reference)
@@ -130,6 +130,7 @@ function(add_lab name)
     else()
       list(APPEND isolated_chain ${dep}_support ${dep}_student)
       list(APPEND links_json "\"${dep}\": \"student\"")
+      list(APPEND student_earlier ${dep})
     endif()
   endforeach()
   # A lab with a reference can only have earlier labs with references (a
@@ -145,8 +146,11 @@ function(add_lab name)
   set(scene_definition CL_LAB_SCENE_DIR="${lab_dir}/scenes")
 
   add_executable(${name} "${lab_dir}/main.cpp")
-  target_link_libraries(${name} PRIVATE ${student_chain} common)
-  target_compile_definitions(${name} PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}")
+  target_link_libraries(${name} PRIVATE ${isolated_chain} common)
+  list(SORT student_earlier)
+  list(JOIN student_earlier " " student_earlier)
+  target_compile_definitions(${name} PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}"
+                             CL_STUDENT_EARLIER_LABS="${student_earlier}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
   file(GLOB test_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/*.cpp")

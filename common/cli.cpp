@@ -76,7 +76,30 @@ Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_
   return scene;
 }
 
-int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body) {
+namespace {
+// "lab01_single_spring lab02_gauss_seidel" -> "lab 01, lab 02"
+std::string lab_numbers(const std::string& labs) {
+  std::istringstream names(labs);
+  std::string name, text;
+  while (names >> name) {
+    if (!text.empty()) text += ", ";
+    text += "lab " + name.substr(3, 2);
+  }
+  return text;
+}
+
+int noting(int code, const std::string& program, const char* student_earlier_labs) {
+  const std::string labs = lab_numbers(student_earlier_labs ? student_earlier_labs : "");
+  if (!labs.empty()) {
+    std::cerr << program << ": note: runs your own code of " << labs
+              << " (no reference in solutions/ yet; docs/DESIGN.md §4)\n";
+  }
+  return code;
+}
+}  // namespace
+
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+             const char* student_earlier_labs) {
   const std::string program = app.get_name();
   try {
     app.parse(argc, argv);
@@ -91,19 +114,19 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
     return 2;
   }
   try {
-    return body();
+    return noting(body(), program, student_earlier_labs);
   } catch (const InputError& error) {
     std::cerr << program << ": " << error.what() << "\n";
     return 2;
   } catch (const NotImplemented& error) {
     std::cerr << program << ": " << error.what() << "; write it, then run again\n";
-    return 3;
+    return noting(3, program, student_earlier_labs);
   } catch (const std::invalid_argument& error) {
     std::cerr << program << ": invalid argument: " << error.what() << "\n";
     return 2;
   } catch (const std::exception& error) {
     std::cerr << program << ": error: " << error.what() << "\n";
-    return 1;
+    return noting(1, program, student_earlier_labs);
   }
 }
 

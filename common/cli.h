@@ -49,9 +49,20 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 // lab_scene_dir, and applies --dt and --steps. Throws InputError.
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir);
 
+// The earlier labs whose reference is not in solutions/ yet, so that a lab
+// executable links the student's own code for them (space-separated; set per
+// executable by cmake/AddLab.cmake, docs/DESIGN.md §4; empty elsewhere).
+#ifndef CL_STUDENT_EARLIER_LABS
+#define CL_STUDENT_EARLIER_LABS ""
+#endif
+
 // Parses the command line and runs `body`, mapping every failure to a single
 // stderr line and exit code: CLI and InputError -> 2, NotImplemented -> 3,
 // anything else -> 1. `body` returns the exit code for a run that finished.
-int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body);
+// A run that gets past its input (exit 0, 1 or 3) and links the student's code
+// of earlier labs (`student_earlier_labs`) says so in one more stderr line; a
+// refusal (exit 2) stays one line.
+int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
+             const char* student_earlier_labs = CL_STUDENT_EARLIER_LABS);
 
 }  // namespace cl
