@@ -64,8 +64,8 @@ TriangleRest make_triangle_rest(const Eigen::Matrix3d& corners);
 //     to push them apart along is defined).
 // A pinned end (w = 0) never moves; the other takes the whole correction.
 // Throws std::invalid_argument for a negative or non-finite inverse mass, a
-// rest length that is not finite and > 0 (σ is undefined for L = 0), a
-// sigma_min that is not finite and > 0, a non-finite sigma_max, or
+// rest length that is not finite or ≤ 0 (σ is undefined for L = 0), a
+// sigma_min that is not finite or ≤ 0, a non-finite sigma_max, or
 // sigma_min > sigma_max.
 lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double inv_mass_i,
                                        double inv_mass_j, double rest_length, double sigma_min, double sigma_max);
@@ -91,7 +91,7 @@ lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::
 // No-op (all zeros): two or three pinned corners (see above), or a triangle of
 // zero area up to round-off (triangle_frame's test: scaling cannot give it an
 // area). Throws std::invalid_argument for a negative or non-finite inverse
-// mass, a rest_area that is not finite and > 0, or sigma_min / sigma_max as
+// mass, a rest_area that is not finite or ≤ 0, or sigma_min / sigma_max as
 // limit_spring says.
 Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen::Vector3d& inv_mass,
                                     double rest_area, double sigma_min, double sigma_max);
@@ -117,7 +117,7 @@ Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen:
 // Zero-area triangles (triangle_frame returns false: collinear or coincident
 // corners) have no frame and no direction to open them in: a no-op (all zeros).
 // Also a no-op: two or three pinned corners. Throws std::invalid_argument for a
-// negative or non-finite inverse mass, a rest whose area is not finite and > 0
+// negative or non-finite inverse mass, a rest whose area is not finite or ≤ 0
 // or whose D_m⁻¹ is not finite, or sigma_min / sigma_max as limit_spring says.
 Eigen::Matrix3d limit_triangle_stretch(const Eigen::Matrix3d& corners, const Eigen::Vector3d& inv_mass,
                                        const TriangleRest& rest, double sigma_min, double sigma_max);

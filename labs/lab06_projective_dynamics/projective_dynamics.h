@@ -37,8 +37,8 @@ struct Problem {
 
 // Given code. Throws std::invalid_argument naming the spring for an index out
 // of range, i == j, a negative or non-finite rest length, or a stiffness that
-// is not finite and > 0 ("inf" is a hard constraint: lab 07), and for dt that
-// is not finite and > 0 or an inverse mass that is negative or not finite.
+// is not finite or ≤ 0 ("inf" is a hard constraint: lab 07), and for dt that
+// is not finite or ≤ 0 or an inverse mass that is negative or not finite.
 Problem make_problem(const Eigen::VectorXd& inv_mass, std::vector<Spring> springs, double dt);
 
 // TODO(lab06.1) — the local step: each spring's projection onto its rest length.
@@ -63,8 +63,8 @@ Eigen::Matrix3Xd local_step(const Eigen::Matrix3Xd& x, const std::vector<Spring>
 // with one pinned end adds k_e at its movable end's diagonal only; a spring
 // with both ends pinned adds nothing. Symmetric positive definite.
 // Build it from triplets with cl::assemble (common/sparse.h).
-// Throws std::invalid_argument for dt not finite and > 0, or a stiffness not
-// finite and > 0 (naming the spring).
+// Throws std::invalid_argument for dt not finite or ≤ 0, or a stiffness that
+// is not finite or ≤ 0 (naming the spring).
 SparseMatrix system_matrix(const Problem& problem);
 
 // TODO(lab06.3) — the right-hand side of A x = b for fixed projections d:

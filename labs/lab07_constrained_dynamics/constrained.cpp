@@ -38,8 +38,8 @@ SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Sp
 // M = diag(1/step.inv_mass) (3u entries). C's entries go in only where they are
 // non-zero, and not at all when step.compliance is empty (every spring hard).
 // Throw std::invalid_argument when sizes disagree (jacobian m × 3u, phi m,
-// compliance m or empty, inv_mass and velocity 3u), dt is not finite and > 0,
-// or an inverse mass is not finite and > 0.
+// compliance m or empty, inv_mass and velocity 3u), dt is not finite or ≤ 0,
+// or an inverse mass is not finite or ≤ 0.
 // Graded by tests/lab07_constrained_dynamics/test_kkt.cpp.
 KktSystem kkt_system(const LinearizedStep& step) {
   (void)step;
@@ -79,7 +79,7 @@ StepSolution solve_schur(const LinearizedStep& step) {
 // TODO(lab07.5) [3 pts] The update: v ← v_new for every movable particle
 // (scatter `velocity` over map's unknowns), v = 0 for a pinned one, then
 // x ← x + Δt v. Throw std::invalid_argument before changing anything when dt
-// is not finite and > 0 or the sizes disagree (velocity must have 3u entries).
+// is not finite or ≤ 0 or the sizes disagree (velocity must have 3u entries).
 // Graded by tests/lab07_constrained_dynamics/test_physics.cpp (C = 0 meets
 // the linearised constraint, the hanging bead, the pendulum's period).
 void update_positions(Particles& particles, const MovableMap& map, const Eigen::VectorXd& velocity, double dt) {

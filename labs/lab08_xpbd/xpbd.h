@@ -82,7 +82,7 @@ struct XpbdSettings {
 //
 // Shapes: particles.x and .v are 3 × n, updated in place; inv_mass has n
 // entries. Throws std::invalid_argument, before changing anything, for dt not
-// finite and > 0, iterations < 0, v / inv_mass not sized for n particles, a
+// finite or ≤ 0, iterations < 0, v / inv_mass not sized for n particles, a
 // spring index or an `order` entry out of range, or a stiffness not > 0.
 void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, const XpbdSettings& settings,
                Eigen::VectorXd& lambda);
