@@ -45,9 +45,12 @@ Problem make_problem(const Eigen::VectorXd& inv_mass, std::vector<Spring> spring
 //
 //     d_e = L_e (x_i − x_j) / ‖x_i − x_j‖
 //
-// the point of the sphere of radius L_e closest to x_i − x_j. When the ends
-// coincide (‖x_i − x_j‖ computes to 0) every point of the sphere is equally
-// close: return d_e = L_e (1, 0, 0). Rest length 0 gives d_e = 0.
+// the point of the sphere of radius L_e closest to x_i − x_j. The ends count
+// as coincident when the computed length (Eigen's norm(), the root of the
+// squared length) is 0 — for ends that are equal, and for ends closer than
+// about 1e-162 m, whose squared length underflows to 0. Every point of the
+// sphere is then equally close: return d_e = L_e (1, 0, 0). Rest length 0 gives
+// d_e = 0. (The given Newton code uses the same rule and direction.)
 //
 // x: 3 × n positions. Returns 3 × m, column e for springs[e]. Never NaN for
 // finite x. Throws std::invalid_argument for a spring index out of range.
