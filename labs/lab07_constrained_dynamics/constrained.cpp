@@ -55,8 +55,9 @@ KktSystem kkt_system(const LinearizedStep& step) {
 // and a one-line problem (never NaN). Throw std::invalid_argument when the matrix
 // is not square, the rhs has the wrong size, or velocity_unknowns is outside
 // [0, size].
-// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (one 1-D spring
-// in closed form, both methods).
+// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (a 1-D spring in
+// closed form, 1) and test_agreement.cpp (a dense solve on random scenes, 1);
+// both hand you the KKT system the test writes out, not your kkt_system's.
 StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) {
   (void)system, (void)velocity_unknowns;
   not_implemented("solve_kkt", __FILE__);
@@ -69,8 +70,9 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
 // Factor S with cl::SpdFactorization; when factor() refuses, return ok = false
 // with a problem line containing "singular". With no springs (m = 0) return
 // v_new = v + Δt g and an empty λ. Check the step as kkt_system does.
-// Graded by tests/lab07_constrained_dynamics/test_agreement.cpp (KKT and Schur
-// agree on random scenes, 3) and test_redundant.cpp (2).
+// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (a 1-D spring in
+// closed form, 1), test_agreement.cpp (a dense solve of the KKT system on
+// random scenes, 2) and test_redundant.cpp (2).
 StepSolution solve_schur(const LinearizedStep& step) {
   (void)step;
   not_implemented("solve_schur", __FILE__);
