@@ -20,7 +20,7 @@ LIST_TIMEOUT = 60  # seconds for a listing
 UNSELECTABLE = re.compile(r'[,\[\]*\\"]|^~|^exclude:')
 PTS_TAG = re.compile(r"\[pts=([^\]]*)\]", re.IGNORECASE)
 # Cases tagged [hidden] (in tests/*/hidden_*.cpp) run only in the Gradescope
-# bundle (tools/autograder.py) and in the honesty checks; local grading skips them.
+# bundle (tools/cl/autograder.py) and in the honesty checks; local grading skips them.
 HIDDEN_TAG = "[hidden]"
 FAILURE_TAGS = ("Expression", "Exception", "FatalErrorCondition", "Failure")
 # OpenMP threads that wait sleep instead of spinning: on a shared or busy
