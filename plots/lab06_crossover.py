@@ -8,24 +8,12 @@ labs/lab06_projective_dynamics/demo.txt) and writes next to it:
   crossover.md    the same numbers as a table, with iterations and factorizations
 Exit 4 when the data are absent.
 """
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab06_projective_dynamics"
-COMMAND = ("./course run lab06_solution --convergence --sweep-scenes "
-           "pd-curtain-16,pd-curtain-32,pd-curtain-64,pd-curtain-128 --out out/lab06_projective_dynamics "
-           "(or ./course demo)")
-
-
-def read_rows(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COMMAND = figures.make_command(LAB, "--convergence --sweep-scenes pd-curtain-16,pd-curtain-32,pd-curtain-64,"
+                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo)")
 
 
 def figure(rows, path):
@@ -56,8 +44,7 @@ def figure(rows, path):
         axis.legend(fontsize=7)
     plot.suptitle("Lab 06: time to an accuracy, one step of the curtains (labels: runs that did not get there)")
     plot.tight_layout()
-    plot.savefig(path, dpi=120)
-    plt.close(plot)
+    figures.save(plot, path, dpi=120)
 
 
 def table(rows, path):
@@ -80,22 +67,19 @@ def table(rows, path):
     path.write_text("\n".join(lines) + "\n")
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab06_crossover.py OUTDIR", file=sys.stderr)
-        return 2
-    source = Path(argv[1]) / LAB / "crossover.csv"
+def main(out_dir):
+    source = out_dir / LAB / "crossover.csv"
     if not source.is_file():
-        print(f"lab06_crossover: {source} is missing; make it with {COMMAND}", file=sys.stderr)
-        return 4
-    rows = read_rows(source)
-    figure(rows, source.parent / "crossover.png")
-    table(rows, source.parent / "crossover.md")
+        return figures.skip("lab06_crossover", f"{source} is missing; make it with {COMMAND}")
+    if not figures.up_to_date([source.parent / "crossover.png", source.parent / "crossover.md"], [source]):
+        rows = figures.rows(source)
+        figure(rows, source.parent / "crossover.png")
+        table(rows, source.parent / "crossover.md")
     wrinkled = source.parent / "wrinkled" / "crossover.csv"
-    if wrinkled.is_file():
-        table(read_rows(wrinkled), wrinkled.parent / "crossover.md")
+    if wrinkled.is_file() and not figures.up_to_date(wrinkled.parent / "crossover.md", [wrinkled]):
+        table(figures.rows(wrinkled), wrinkled.parent / "crossover.md")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

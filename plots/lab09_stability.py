@@ -8,22 +8,14 @@ driver's 2/omega_max, where symplectic Euler on the chain's sideways
 vibrations stops being stable.
 
 Writes OUTDIR/lab09_stable_constrained/stability.png."""
-import csv
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab09_stable_constrained"
 COMMAND = "./course demo (or ./course run lab09 --sweep-mass-ratios 1,10,100,1000,10000,100000,1000000 --out out/lab09_stable_constrained)"
 STYLE = {"off": ("tab:red", "without K_g (lab 07)"), "on": ("tab:blue", "with K_g")}
-
-
-def number(text):
-    return float(text) if text not in ("", None) else None
 
 
 def main(out_dir):
@@ -31,15 +23,13 @@ def main(out_dir):
     limits_path, runs_path = folder / "stability.csv", folder / "stability_runs.csv"
     for path in (limits_path, runs_path):
         if not path.exists():
-            print(f"lab09_stability: no {path} (make it with {COMMAND})")
-            return 4
-    with open(limits_path, newline="") as handle:
-        limits = list(csv.DictReader(handle))
-    with open(runs_path, newline="") as handle:
-        runs = list(csv.DictReader(handle))
+            return figures.skip("lab09_stability", f"no {path} (make it with {COMMAND})")
+    limits, runs = figures.rows(limits_path), figures.rows(runs_path)
     if not limits:
-        print(f"lab09_stability: {limits_path} has no rows (make it with {COMMAND})")
-        return 4
+        return figures.skip("lab09_stability", f"{limits_path} has no rows (make it with {COMMAND})")
+    target = folder / "stability.png"
+    if figures.up_to_date(target, [limits_path, runs_path]):
+        return 0
 
     figure, axes = plt.subplots(figsize=(7.5, 5.0))
     offsets = {"off": 0.93, "on": 1.07}  # side by side, so both modes' markers show
@@ -48,7 +38,7 @@ def main(out_dir):
         if not rows:
             continue
         ratio = [float(r["mass_ratio"]) for r in rows]
-        largest = [number(r["largest_stable_dt"]) for r in rows]
+        largest = [figures.number(r["largest_stable_dt"]) for r in rows]
         points = [(x, y) for x, y in zip(ratio, largest) if y is not None]
         if points:
             axes.loglog(*zip(*points), "-", color=colour, lw=2, label=f"largest stable Δt, {label}")
@@ -77,12 +67,9 @@ def main(out_dir):
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8, loc="lower left")
     figure.tight_layout()
-    target = folder / "stability.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

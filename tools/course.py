@@ -32,7 +32,8 @@ usage: ./course COMMAND [ARGS]
   autograder labNN [--out FILE.zip]  the Gradescope autograder for lab NN (its hidden tests
                                      too): build/gradescope/labNN.zip
   run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference
-  plots [DIR]                        figures from the CSV/JSON in DIR (out/)
+  plots [labNN ...] [DIR] [-v]       the figures whose CSV/JSON in DIR (out/, or out/labNN_name)
+                                     changed since drawn; -v: list the rest, --force: redraw all
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
   extremes [--quick]                 the extremes matrix: finite, reported or silent NaN -> out/bench
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)

@@ -211,9 +211,9 @@ def cmd_test(argv):
         check_measurements(checks, out)
         check_fuzz(checks)
         check_sanitize(checks)
-    for script, (status, error) in run_plots(out, echo=False).items():
-        checks.record(status in ("ok", "skipped") if is_release() else status == "ok",
-                      f"plots/{script} on {show(out)}: {status}", error)
+    for script, outcome in run_plots(out, echo=False).items():
+        checks.record(outcome.status in ("ok", "skipped") if is_release() else outcome.status == "ok",
+                      f"plots/{script} on {show(out)}: {outcome.status}", outcome.lines)
     if not is_release():
         check_student_loop(checks)
         check_autograder(checks)
