@@ -19,7 +19,7 @@ def draw(source, summary, target):
     if not rows:
         return
     time = figures.column(rows, "time")
-    figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.0))
+    figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.6))
     left.plot(time, figures.column(rows, "max_strain"), label="max strain")
     left.plot(time, figures.column(rows, "min_strain"), label="min strain")
     title = source.parent.name
@@ -46,7 +46,8 @@ def draw(source, summary, target):
     right.set_ylabel("energy (J)")
     if max(max(kinetic), max(elastic)) > 100 * max(min(abs(t) for t in total), 1e-12):
         right.set_yscale("symlog", linthresh=1e-2)
-    right.legend(fontsize=8)
+    # Below the panel: inside it, the legend would cover the total energy (issue 25).
+    right.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
     right.grid(True, alpha=0.3)
     figure.suptitle(title, fontsize=11)
     figure.tight_layout()

@@ -30,8 +30,10 @@ def main(out_dir):
     target = folder / "stability.png"
     if figures.up_to_date(target, [limits_path, runs_path]):
         return 0
+    from matplotlib.lines import Line2D
 
-    figure, axes = plt.subplots(figsize=(7.5, 5.0))
+    figure, axes = plt.subplots(figsize=(7.5, 5.8))
+    arrows = []
     offsets = {"off": 0.93, "on": 1.07}  # side by side, so both modes' markers show
     for mode, (colour, label) in STYLE.items():
         rows = [r for r in limits if r["geometric_stiffness"] == mode]
@@ -47,9 +49,9 @@ def main(out_dir):
                  if y is not None and r["first_unstable_dt"] == ""]
         for x, y in never:
             axes.annotate("", xy=(x, y * 1.6), xytext=(x, y), arrowprops={"arrowstyle": "->", "color": colour})
-        if never:
-            axes.text(never[0][0], never[0][1] * 0.75, "no unstable Δt up to the largest tried", color=colour,
-                      fontsize=8, va="top")
+        if never:  # in the legend: over the plot, the words covered the markers (issue 25)
+            arrows.append((Line2D([], [], color=colour, marker="$\\uparrow$", ms=10, ls=""),
+                           f"no unstable Δt up to the largest tried, {label}"))
         tried = [r for r in runs if r["geometric_stiffness"] == mode]
         stable = [(float(r["mass_ratio"]) * offsets[mode], float(r["dt"])) for r in tried if r["stable"] == "1"]
         unstable = [(float(r["mass_ratio"]) * offsets[mode], float(r["dt"])) for r in tried if r["stable"] != "1"]
@@ -65,7 +67,11 @@ def main(out_dir):
     axes.set_title(f"heavy chain, {first['links']} hard links, {first['steps']} steps per run, "
                    f"method {first['method']}", fontsize=10)
     axes.grid(True, which="both", alpha=0.3)
-    axes.legend(fontsize=8, loc="lower left")
+    handles, labels = axes.get_legend_handles_labels()
+    handles += [handle for handle, _ in arrows]
+    labels += [text for _, text in arrows]
+    axes.legend(handles, labels, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                frameon=False)
     figure.tight_layout()
     figures.save(figure, target)
     return 0
