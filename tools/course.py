@@ -31,7 +31,8 @@ usage: ./course COMMAND [ARGS]
                                      reference code of the labs before NN
   autograder labNN [--out FILE.zip]  the Gradescope autograder for lab NN (its hidden tests
                                      too): build/gradescope/labNN.zip
-  run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference
+  run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference,
+                                     where solutions/ holds it
   plots [labNN ...] [DIR] [-v]       the figures whose CSV/JSON in DIR (out/, or out/labNN_name)
                                      changed since drawn; -v: list the rest, --force: redraw all
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)

@@ -101,7 +101,7 @@ def cmd_demo(argv):
 
 def cmd_run(argv):
     if not argv or argv[0].startswith("-"):
-        raise CourseError("usage: ./course run labNN [ARGS]  (labNN_solution: the reference)", code=2)
+        raise CourseError("usage: ./course run labNN [ARGS]  (labNN_solution: the reference, where solutions/ holds it)", code=2)
     token, solution = argv[0], argv[0].endswith("_solution")
     lab = resolve_lab(token.removesuffix("_solution"))
     configure(log=sys.stderr)

@@ -84,7 +84,8 @@ def print_outcomes(outcomes, verbose):
             for path in outcome.current:
                 print(f"  up to date: {path}")
             if outcome.status == "skipped":
-                print(f"  no data for plots/{name}: {' '.join(outcome.lines)}")
+                reason = " ".join(outcome.lines).removeprefix(name.removesuffix(".py") + ": ")
+                print(f"  plots/{name}: {reason}")
     current = sum(len(o.current) for o in outcomes.values())
     absent = [name for name, o in outcomes.items() if o.status == "skipped"]
     if current or absent:
