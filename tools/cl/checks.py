@@ -4,6 +4,8 @@ import shlex
 import shutil
 import subprocess
 import tempfile
+import time
+from contextlib import contextmanager
 from pathlib import Path
 
 from . import grade
@@ -22,11 +24,24 @@ from .student_loop import check_student_loop
 
 
 class Checks:
-    """Counts and prints pass/fail checks."""
+    """Counts and prints pass/fail checks, and times the steps that make them."""
 
     def __init__(self):
         self.passed = 0
         self.failed = 0
+        self.started = time.monotonic()
+        self.times = []  # (step, seconds, ran alongside other steps)
+
+    @contextmanager
+    def timed(self, step):
+        start = time.monotonic()
+        try:
+            yield
+        finally:
+            self.add_time(step, time.monotonic() - start)
+
+    def add_time(self, step, seconds, concurrent=False):
+        self.times.append((step, seconds, concurrent))
 
     def record(self, ok, name, details=()):
         if ok:
@@ -37,8 +52,25 @@ class Checks:
         for line in details:
             print(f"        {line}")
 
+    def print_times(self):
+        """The timing table: each step's seconds and share of the whole run (a step
+        that ran alongside others has no share: its time is inside theirs)."""
+        total = max(time.monotonic() - self.started, 1e-9)
+        if not self.times:
+            return
+        rest = "(the rest: listing, waiting, Python)"
+        width = max(len(step) for step, _, _ in [*self.times, (rest, 0, False)])
+        print(f"\ntiming: {total:.0f} s in all")
+        for step, seconds, concurrent in self.times:
+            share = "alongside" if concurrent else f"{100 * seconds / total:5.1f} %"
+            print(f"  {step:<{width}}  {seconds:7.1f} s  {share}")
+        counted = sum(seconds for _, seconds, concurrent in self.times if not concurrent)
+        print(f"  {rest:<{width}}  {total - counted:7.1f} s  "
+              f"{100 * (total - counted) / total:5.1f} %")
+
     def finish(self):
-        """Print `N passed, M failed`; return the exit code."""
+        """Print the timing table and `N passed, M failed`; return the exit code."""
+        self.print_times()
         print(f"{self.passed} passed, {self.failed} failed")
         return 1 if self.failed else 0
 
@@ -55,7 +87,8 @@ def build_labs(checks, labs):
         if entry["reference"]:
             targets += [f"{lab}_solution", *lab_targets(lab, solutions=True)]
         try:
-            build_targets(list(dict.fromkeys(targets)), log=None)
+            with checks.timed(f"build {lab}"):
+                build_targets(list(dict.fromkeys(targets)), log=None)
         except BuildFailure as failure:
             checks.record(False, f"{lab} does not build", failure.lines)
             continue
@@ -65,12 +98,14 @@ def build_labs(checks, labs):
 
 def check_ctest(checks):
     try:
-        build_targets(["common_tests"], log=None)
+        with checks.timed("build common_tests"):
+            build_targets(["common_tests"], log=None)
     except BuildFailure as failure:
         checks.record(False, "common_tests does not build", failure.lines)
         return
-    done = subprocess.run(["ctest", "--test-dir", str(BUILD), "-L", "unit", "--output-on-failure"],
-                          cwd=ROOT, capture_output=True, text=True, check=False)
+    with checks.timed("unit tests (ctest -L unit)"):
+        done = subprocess.run(["ctest", "--test-dir", str(BUILD), "-L", "unit", "--output-on-failure"],
+                              cwd=ROOT, capture_output=True, text=True, check=False)
     ok = done.returncode == 0
     lines = [line for line in done.stdout.splitlines() if "tests passed" in line]
     details = [] if ok else (done.stdout + done.stderr).splitlines()
@@ -186,7 +221,8 @@ def cmd_test(argv):
     argparse.ArgumentParser(prog="course test").parse_args(argv)
     checks = Checks()
     try:
-        configure()
+        with checks.timed("configure"):
+            configure()
     except CourseError as error:
         checks.record(False, str(error), error.details)
         return checks.finish()
@@ -195,26 +231,40 @@ def cmd_test(argv):
     out = BUILD / "test-demo"
     if is_release():
         print("a student release: grading your code (a score, not a check)")
-        report_student_score(labs)
+        with checks.timed("grading your code"):
+            report_student_score(labs)
         with_reference = [lab for lab in labs if manifest()[lab]["reference"]]
-        check_demo(checks, out, with_reference, student_fallback=False)
-        check_rejects(checks, with_reference)
+        with checks.timed("demo"):
+            check_demo(checks, out, with_reference, student_fallback=False)
+        with checks.timed("rejects"):
+            check_rejects(checks, with_reference)
     else:
         without = [lab for lab in labs if not manifest()[lab]["reference"]]
         for lab in without:
             checks.record(False, f"{lab}: no reference in solutions/{lab}/ (the honesty check needs one)")
         labs = [lab for lab in labs if lab not in without]
-        check_solutions(checks, labs)
-        check_stubs(checks, labs)
-        check_demo(checks, out, labs)
-        check_rejects(checks, labs)
+        # The fuzzer runs on one core for a minute: alongside the honesty checks,
+        # which run one single-threaded test process at a time.
+        fuzzing = check_fuzz(checks)
+        with checks.timed("honesty: the solutions graded"):
+            check_solutions(checks, labs)
+        with checks.timed("honesty: the stubs graded"):
+            check_stubs(checks, labs)
+        if fuzzing:
+            fuzzing()
+        with checks.timed("demo"):
+            check_demo(checks, out, labs)
+        with checks.timed("rejects"):
+            check_rejects(checks, labs)
         check_measurements(checks, out)
-        check_fuzz(checks)
         check_sanitize(checks)
-    for script, outcome in run_plots(out, echo=False).items():
-        checks.record(outcome.status in ("ok", "skipped") if is_release() else outcome.status == "ok",
-                      f"plots/{script} on {show(out)}: {outcome.status}", outcome.lines)
+    with checks.timed("plots (every figure, redrawn)"):
+        for script, outcome in run_plots(out, echo=False).items():
+            checks.record(outcome.status in ("ok", "skipped") if is_release() else outcome.status == "ok",
+                          f"plots/{script} on {show(out)}: {outcome.status}", outcome.lines)
     if not is_release():
-        check_student_loop(checks)
-        check_autograder(checks)
+        with checks.timed("student loop (a temporary release)"):
+            check_student_loop(checks)
+        with checks.timed("autograder (a bundle, five submissions)"):
+            check_autograder(checks)
     return checks.finish()

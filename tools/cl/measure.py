@@ -78,7 +78,8 @@ def check_measurements(checks, out):
     """CI: the quick trade and extremes runs (extremes fails on any silent NaN)."""
     for program in ("trade", "extremes"):
         try:
-            code, lines = run_measurement(program, ["--quick"], out, echo=False)
+            with checks.timed(f"measurements: {program} --quick (build and run)"):
+                code, lines = run_measurement(program, ["--quick"], out, echo=False)
         except (CourseError, BuildFailure) as error:
             checks.record(False, f"{program} --quick: {error}")
             continue

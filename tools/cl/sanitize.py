@@ -23,6 +23,11 @@ def run_sanitized(log=sys.stdout):
     """Build the test suite with -fsanitize=address,undefined (CMakeLists.txt: CL_SANITIZE)
     into BUILD/asan and run every test program there, every case (hidden ones too).
     Return [(program, ok, summary line, report lines)]."""
+    return run_programs(build_sanitized(log))
+
+
+def build_sanitized(log=sys.stdout):
+    """Configure (once) and build the sanitizer build's test programs; return their names."""
     configure(log=log)  # labs.json says which labs have a reference
     if not (SANITIZE_BUILD / "CMakeCache.txt").is_file():
         quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), "-DCL_SANITIZE=ON",
@@ -30,6 +35,11 @@ def run_sanitized(log=sys.stdout):
               "configure the sanitizer build")
     targets = sanitize_targets()
     build_targets(targets, build_dir=SANITIZE_BUILD, log=log, label="the test suite (-fsanitize=address,undefined)")
+    return targets
+
+
+def run_programs(targets):
+    """Run each sanitizer-built test program, every case: [(program, ok, summary line, report lines)]."""
     env = sanitizer_env(leaks=True)
     results = []
     for name in targets:
@@ -63,9 +73,12 @@ def cmd_sanitize(argv):
 def check_sanitize(checks):
     """CI: the whole test suite under ASan and UBSan, clean."""
     try:
-        results = run_sanitized(log=None)
+        with checks.timed("sanitize: build"):
+            targets = build_sanitized(log=None)
     except (CourseError, BuildFailure) as error:
         checks.record(False, f"sanitizer build: {error}", getattr(error, "lines", getattr(error, "details", [])))
         return
+    with checks.timed("sanitize: runs"):
+        results = run_programs(targets)
     for name, ok, summary, report in results:
         checks.record(ok, f"{name} under ASan+UBSan: {summary}", report)
