@@ -76,11 +76,33 @@ def write_release(lab, dest, keep=None):
         target = dest / path
         target.parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / path, target)
+    write_marker(dest, lab, past)
+    return len(files) + 1
+
+
+def advance_release(tree, lab):
+    """Make TREE, a release of an earlier week whose stubs are as shipped, the
+    release for `lab`: add the references now due, rewrite the marker. Return the
+    paths that differ from a fresh write_release(lab) (none, when all is well)."""
+    files, past = release_files(lab)
+    for done in past:
+        if not (tree / "solutions" / done).is_dir():
+            shutil.copytree(ROOT / "solutions" / done, tree / "solutions" / done)
+    write_marker(tree, lab, past)
+    have = {str(p.relative_to(tree)) for p in tree.rglob("*")
+            if p.is_file() and not SKIPPED_DIRS.intersection(p.relative_to(tree).parts)}
+    want = set(files) | {RELEASE_MARKER}
+    differ = sorted(have ^ want)
+    differ += [path for path in sorted(have & want - {RELEASE_MARKER})
+               if (tree / path).read_bytes() != (ROOT / path).read_bytes()]
+    return differ
+
+
+def write_marker(dest, lab, past):
     marker = {"release": lab, "references": past,
               "note": "stubs for every lab; solutions/ holds the reference code of the labs before "
                       f"{grade.lab_id(lab)} (docs/DESIGN.md §4)"}
     (dest / RELEASE_MARKER).write_text(json.dumps(marker, indent=2) + "\n")
-    return len(files) + 1
 
 
 def cmd_release(argv):

@@ -1,6 +1,7 @@
 """The student's loop, checked by ./course test in a temporary student release."""
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -11,7 +12,7 @@ from pathlib import Path
 from . import grade
 from .base import ROOT
 from .labs import lab_dirs
-from .release import write_release
+from .release import advance_release, write_release
 
 
 def sub_course(tree, *args):
@@ -96,4 +97,56 @@ def check_student_loop(checks):
         ok = "crashed (signal" in text and where in text
         checks.record(ok, f"release lab03, lab 01 writes past an unsized matrix: grade names {where}",
                       [] if ok else lines)
+
+        # The same tree and build, a later week: its executables and hints.
+        for lab in (lab1, lab3, lab4):
+            for source in (ROOT / "solutions" / lab).glob("*.cpp"):
+                shutil.copy2(ROOT / "labs" / lab / source.name, tree / "labs" / lab / source.name)
+        if "lab08" in ids:
+            check_later_week(checks, tree, ids)
     checks.record(True, f"student loop checks: {time.monotonic() - start:.0f} s")
+
+
+# Short runs of the student's executables in lab 08's week, with the labs they
+# use from earlier weeks shipped as references: they must run (issue 19: an
+# executable links the reference of every earlier lab that has one). Labs 07
+# and 10 are taken as written (their reference copied into labs/); lab 08 is
+# still its stubs, which --method pbd does not call.
+LATER_WEEK_RUNS = [
+    ("lab10", ["--scene", "flat-curtain-32", "--levels", "2", "--steps", "2"]),
+    ("lab08", ["--scene", "hanging-spring", "--method", "pbd", "--iterations", "1", "--steps", "2"]),
+    ("lab07", ["--scene", "ragdoll-chain-20", "--compare-pbd", "1", "--compare-substeps", "1", "--steps", "2"]),
+]
+WRITTEN = ("lab07", "lab10")  # labs whose student files are the reference in that check
+TARGET = re.compile(r"\b(lab\d\d)(?:_[a-z0-9_]*?)?_solution\b")
+
+
+def check_later_week(checks, tree, ids, week="lab08"):
+    """The lab 03 release advanced to lab 08's week (references of labs 01-07,
+    stubs from 08 on): it equals a fresh release; the student's executables
+    that use earlier labs run; no printed hint names a reference that is not
+    there."""
+    lab = ids[week]
+    differ = advance_release(tree, lab)
+    checks.record(not differ, f"release lab03 advanced to {week}: the same files as ./course release {week}",
+                  differ[:10])
+    present = {grade.lab_id(p.name) for p in (tree / "solutions").iterdir()}
+    for written in (ids[tag] for tag in WRITTEN if tag in ids):
+        for source in (ROOT / "solutions" / written).glob("*.cpp"):
+            shutil.copy(source, tree / "labs" / written / source.name)  # a new mtime: make rebuilds it
+    said = []
+    for program, args in LATER_WEEK_RUNS:
+        if grade.lab_id(program) not in ids:
+            continue
+        out = tree / "out" / f"later-week-{program}"
+        code, lines = sub_course(tree, "run", program, *args, "--out", str(out))
+        said += lines
+        checks.record(code == 0, f"release {week}: ./course run {program} {' '.join(args)}: exit code {code}",
+                      [] if code == 0 else lines[-8:])
+    empty = tree / "out" / "nothing-yet"
+    empty.mkdir(parents=True, exist_ok=True)
+    for command in (["plots", "-v", str(empty)], ["help"], ["run"]):
+        said += sub_course(tree, *command)[1]
+    missing = sorted({line.strip() for line in said for m in TARGET.finditer(line) if m[1] not in present})
+    checks.record(not missing, f"release {week}: no printed hint names a reference that is not shipped "
+                  f"(./course plots -v, help, run)", missing[:10])
