@@ -1,6 +1,6 @@
 """Where the course is, and the error a user can fix.
 
-Every module of the package imports this one; it imports none of them.
+Every module of the package but grade imports this one; it imports only grade.
 """
 import os
 from pathlib import Path
