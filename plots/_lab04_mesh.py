@@ -4,8 +4,6 @@ import re
 from pathlib import Path
 
 import numpy as np
-from matplotlib import colors
-from matplotlib.collections import LineCollection, PolyCollection
 
 LAB = "lab04_pbd"
 HEADER = re.compile(r"#.*scene (\S+) frame (\d+) time (\S+)")
@@ -82,17 +80,19 @@ def stretch(frame, rest):
     return np.abs(length / np.where(rest_length > 0, rest_length, 1.0) - 1.0)
 
 
-STRETCH_NORM = colors.LogNorm(vmin=1e-3, vmax=3.0)
+STRETCH_RANGE = (1e-3, 3.0)  # the colour scale of edge stretch, log
 CMAP = "YlOrRd"
 
 
 def draw(axes, frame, rest, limits):
     """Draw `frame` into `axes`, coloured by stretch against `rest`; return the mappable."""
     import matplotlib.cm as cm
+    from matplotlib import colors
+    from matplotlib.collections import LineCollection, PolyCollection
 
-    mapper = cm.ScalarMappable(norm=STRETCH_NORM, cmap=CMAP)
+    mapper = cm.ScalarMappable(norm=colors.LogNorm(*STRETCH_RANGE), cmap=CMAP)
     p = screen(frame.vertices)
-    per_edge = np.clip(stretch(frame, rest), STRETCH_NORM.vmin, None)
+    per_edge = np.clip(stretch(frame, rest), STRETCH_RANGE[0], None)
     if len(frame.faces):
         m = len(frame.faces)
         per_face = per_edge.reshape(3, m).max(axis=0)

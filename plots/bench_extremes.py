@@ -3,16 +3,10 @@
 unstable, not applicable, silent NaN) as a heat map, one panel per geometry and
 iteration count; rows are the methods, columns stiffness × Δt × mass ratio.
 Reads OUTDIR/bench/extremes.csv, writes OUTDIR/bench/extremes.png."""
-import csv
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.colors import ListedColormap  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 COMMAND = "./course extremes  (or: build/bin/extremes --out out/bench)"
 OUTCOMES = ["finite", "reported", "not-applicable", "silent-nan"]
@@ -23,10 +17,13 @@ def main(out_dir):
     bench = Path(out_dir) / "bench"
     table = bench / "extremes.csv"
     if not table.exists():
-        print(f"bench_extremes: no {table}; make it with {COMMAND}")
-        return 4
-    with open(table, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+        return figures.skip("bench_extremes", f"no {table}; make it with {COMMAND}")
+    target = bench / "extremes.png"
+    if figures.up_to_date(target, [table]):
+        return 0
+    from matplotlib.colors import ListedColormap
+    from matplotlib.patches import Patch
+    rows = figures.rows(table)
     methods = list(dict.fromkeys(r["method"] for r in rows))
     geometries = list(dict.fromkeys(r["geometry"] for r in rows))
     iterations = list(dict.fromkeys(r["iterations"] for r in rows))
@@ -63,12 +60,9 @@ def main(out_dir):
     figure.suptitle(f"Outcome per cell. Within each stiffness block: Δt = {dt_text} s (left to right), each split "
                     f"into mass ratio {ratio_text}", fontsize=10)
     figure.tight_layout(rect=(0, 0.04, 1, 0.97))
-    target = bench / "extremes.png"
-    figure.savefig(target, dpi=100)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target, dpi=100)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -4,14 +4,10 @@ step for every method and iteration count, the Pareto front highlighted. Top
 row: max strain error; bottom row: distance to the converged reference step,
 relative to the step's displacement. Reads OUTDIR/bench/trade.csv, writes
 OUTDIR/bench/pareto.png."""
-import csv
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 COMMAND = "./course bench  (or: build/bin/trade --out out/bench)"
 FAMILY_MARKER = {"hard": "s", "implicit-euler": "o", "linearized": "D", "limited": "v"}
@@ -31,10 +27,11 @@ def main(out_dir):
     bench = Path(out_dir) / "bench"
     table = bench / "trade.csv"
     if not table.exists():
-        print(f"bench_pareto: no {table}; make it with {COMMAND}")
-        return 4
-    with open(table, newline="") as handle:
-        rows = [r for r in csv.DictReader(handle) if not r["problem"]]
+        return figures.skip("bench_pareto", f"no {table}; make it with {COMMAND}")
+    target = bench / "pareto.png"
+    if figures.up_to_date(target, [table]):
+        return 0
+    rows = [r for r in figures.rows(table) if not r["problem"]]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
     colors = {m: plt.cm.tab10(i % 10) for i, m in enumerate(methods)}
@@ -76,12 +73,9 @@ def main(out_dir):
     figure.suptitle("Error against time per step: one step from a shared state, K growing along each line "
                     "(circles: the Pareto front)", fontsize=11)
     figure.tight_layout(rect=(0, 0.09, 1, 0.96))
-    target = bench / "pareto.png"
-    figure.savefig(target, dpi=100)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target, dpi=100)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -2,15 +2,11 @@
 """The speed/accuracy trade (issue 12): wall time per iteration against the
 curtain's size, log-log, with each method's fitted exponent p (time ~ n^p) in
 the legend. Reads OUTDIR/bench/trade_scaling.csv, writes OUTDIR/bench/scaling.png."""
-import csv
 import math
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 COMMAND = "./course bench  (or: build/bin/trade --out out/bench)"
 
@@ -25,10 +21,11 @@ def main(out_dir):
     bench = Path(out_dir) / "bench"
     table = bench / "trade_scaling.csv"
     if not table.exists():
-        print(f"bench_scaling: no {table}; make it with {COMMAND}")
-        return 4
-    with open(table, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+        return figures.skip("bench_scaling", f"no {table}; make it with {COMMAND}")
+    target = bench / "scaling.png"
+    if figures.up_to_date(target, [table]):
+        return 0
+    rows = figures.rows(table)
     methods = list(dict.fromkeys(r["method"] for r in rows))
     figure, ax = plt.subplots(figsize=(7.5, 5.4))
     for i, method in enumerate(methods):
@@ -43,12 +40,9 @@ def main(out_dir):
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
     figure.tight_layout()
-    target = bench / "scaling.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target, dpi=110)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

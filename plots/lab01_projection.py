@@ -2,22 +2,13 @@
 """Lab 01: before and after one projection pass, drawn in the x-y plane, one
 panel per demo scene (each OUT/lab01_single_spring/<scene>/ with positions.csv
 and springs.csv)."""
-import csv
 import math
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab01_single_spring"
-
-
-def read_rows(path):
-    with open(path, newline="") as handle:
-        return [{key: float(value) for key, value in row.items()} for row in csv.DictReader(handle)]
 
 
 def draw_case(axes, name, positions, springs):
@@ -50,23 +41,25 @@ def main(out_dir):
     lab_dir = Path(out_dir) / LAB
     cases = sorted(p for p in lab_dir.glob("*") if (p / "positions.csv").exists() and (p / "springs.csv").exists())
     if not cases:
-        print(f"lab01_projection: needs {lab_dir}/SCENE/positions.csv and springs.csv; make them with: "
-              f"./course run lab01_solution --scene triangle --out {lab_dir}/triangle (every scene: ./course demo)")
-        return 4
+        return figures.skip("lab01_projection", f"needs {lab_dir}/SCENE/positions.csv and springs.csv; make them "
+                            "with: " + figures.make_command(LAB, f"--scene triangle --out {lab_dir}/triangle")
+                            + " (every scene: ./course demo)")
+    target = lab_dir / "projection_before_after.png"
+    if figures.up_to_date(target, [c / name for c in cases for name in ("positions.csv", "springs.csv")]):
+        return 0
     columns = min(3, len(cases))
     rows = math.ceil(len(cases) / columns)
     figure, grid = plt.subplots(rows, columns, figsize=(4.0 * columns, 3.8 * rows), squeeze=False)
     for axes, case in zip(grid.flat, cases):
-        draw_case(axes, case.name, read_rows(case / "positions.csv"), read_rows(case / "springs.csv"))
+        draw_case(axes, case.name, figures.numeric_rows(case / "positions.csv"),
+                  figures.numeric_rows(case / "springs.csv"))
     for axes in list(grid.flat)[len(cases):]:
         axes.axis("off")
     figure.suptitle("One projection per spring: before (hollow, dashed) and after (filled, solid); squares are pinned")
     figure.tight_layout()
-    target = lab_dir / "projection_before_after.png"
-    figure.savefig(target, dpi=110)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

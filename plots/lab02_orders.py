@@ -8,15 +8,8 @@ Reads OUTDIR/lab02_gauss_seidel/<scene>-<order>.json and <scene>-<order>/*.csv
   lab02_order_difference.png  how far apart the final states of two orders are
 Exit 4 when the runs are absent.
 """
-import csv
-import json
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab02_gauss_seidel"
 SCENES = [("chain", "perturbed chain (20 links)"),
@@ -26,12 +19,6 @@ ORDERS = [("forward", "tab:blue"), ("reverse", "tab:orange"), ("random", "tab:gr
 FLOOR = 1e-17  # an error of exactly 0 is drawn here on the log axis
 
 
-def read_csv(path):
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    return {key: [float(row[key]) for row in rows] for key in rows[0]} if rows else {}
-
-
 def load_runs(lab_dir):
     runs = {}
     for prefix, _ in SCENES:
@@ -39,7 +26,7 @@ def load_runs(lab_dir):
             name = f"{prefix}-{order}"
             summary, table = lab_dir / f"{name}.json", lab_dir / name / "convergence.csv"
             if summary.is_file() and table.is_file():
-                runs[name] = (json.loads(summary.read_text()), read_csv(table))
+                runs[name] = (figures.summary(summary), figures.columns(table))
     return runs
 
 
@@ -67,8 +54,7 @@ def convergence_figure(runs, x_key, x_label, x_scale, path):
         axis.legend(fontsize=8)
     figure.suptitle("Lab 02: Gauss-Seidel, one curve per spring order (dotted: tolerance)")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
 def difference_figure(lab_dir, runs, path):
@@ -80,7 +66,7 @@ def difference_figure(lab_dir, runs, path):
             axis.set_visible(False)
             continue
         summary, _ = runs[name]
-        table = read_csv(positions)
+        table = figures.columns(positions)
         if "x_compare" not in table:
             axis.set_visible(False)
             continue
@@ -101,26 +87,27 @@ def difference_figure(lab_dir, runs, path):
         axis.legend(fontsize=8)
     figure.suptitle("Both orders satisfy every spring to round-off, at different positions (0 is drawn at 1e-17)")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab02_orders.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
+def main(out_dir):
+    lab_dir = out_dir / LAB
     runs = load_runs(lab_dir)
     if not runs:
-        print(f"lab02_orders: needs {lab_dir}/chain-forward.json and chain-forward/convergence.csv (and the "
-              f"other order runs of labs/lab02_gauss_seidel/demo.txt); make them with: ./course demo "
-              f"--out {argv[1]}", file=sys.stderr)
-        return 4
-    convergence_figure(runs, "sweep", "sweep", 1.0, lab_dir / "lab02_orders.png")
-    convergence_figure(runs, "total_seconds", "wall time of the sweeps (ms)", 1e3, lab_dir / "lab02_error_vs_time.png")
-    difference_figure(lab_dir, runs, lab_dir / "lab02_order_difference.png")
+        return figures.skip("lab02_orders", f"needs {lab_dir}/chain-forward.json and chain-forward/convergence.csv "
+                            f"(and the other order runs of labs/lab02_gauss_seidel/demo.txt); make them with: "
+                            f"./course demo --out {out_dir}")
+    sources = [path for name in runs for path in (lab_dir / f"{name}.json", *(lab_dir / name).glob("*.csv"))]
+    for target, draw in ((lab_dir / "lab02_orders.png",
+                          lambda path: convergence_figure(runs, "sweep", "sweep", 1.0, path)),
+                         (lab_dir / "lab02_error_vs_time.png",
+                          lambda path: convergence_figure(runs, "total_seconds", "wall time of the sweeps (ms)",
+                                                          1e3, path)),
+                         (lab_dir / "lab02_order_difference.png", lambda path: difference_figure(lab_dir, runs, path))):
+        if not figures.up_to_date(target, sources):
+            draw(target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

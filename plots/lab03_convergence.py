@@ -9,25 +9,12 @@ labs/lab03_jacobi/demo.txt) and writes, next to them:
 Runs that diverged end in a red cross; they are drawn, not dropped.
 Exit 4 when the runs are absent.
 """
-import csv
-import json
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab03_jacobi"
 SCENES = [("chain", "chain-20 (near its solution)"), ("cloth", "perturbed cloth 16x16 (lab 02)")]
 FLOOR = 1e-17  # an error of exactly 0 is drawn here on the log axis
-
-
-def read_csv(path):
-    with open(path, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    return {key: [float(row[key]) for row in rows] for key in rows[0]} if rows else {}
 
 
 def load(lab_dir, prefix):
@@ -41,8 +28,7 @@ def load(lab_dir, prefix):
         table_path = lab_dir / summary_path.stem / "convergence.csv"
         if not table_path.is_file():
             continue
-        summary = json.loads(summary_path.read_text())
-        runs.append((summary, read_csv(table_path)))
+        runs.append((figures.summary(summary_path), figures.columns(table_path)))
     runs.sort(key=lambda run: (run[0]["method"] != "gauss-seidel", run[0].get("averaging") == "none",
                                run[0].get("omega", 0.0)))
     return runs
@@ -94,8 +80,7 @@ def comparison_figure(lab_dir, x_key, x_label, x_scale, path):
         axis.set_xlabel(x_label)
     figure.suptitle("Lab 03: Gauss-Seidel against averaged Jacobi (dotted: tolerance, red x: diverged)")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
 def omega_figure(lab_dir, path):
@@ -126,26 +111,26 @@ def omega_figure(lab_dir, path):
     right.set_title("anchored particle: (1 - omega) delta per sweep")
     figure.suptitle("Lab 03: the relaxation factor omega (0 is drawn at 1e-17)")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab03_convergence.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
+def main(out_dir):
+    lab_dir = out_dir / LAB
     if not any(load(lab_dir, prefix) for prefix, _ in SCENES):
-        print(f"lab03_convergence: needs {lab_dir}/chain-gs.json and chain-gs/convergence.csv (and the other "
-              f"chain-*/cloth-* runs of labs/lab03_jacobi/demo.txt); make them with: ./course demo --out {argv[1]}",
-              file=sys.stderr)
-        return 4
-    comparison_figure(lab_dir, "sweep", "sweep", 1.0, lab_dir / "lab03_gs_vs_jacobi.png")
-    comparison_figure(lab_dir, "total_seconds", "wall time of the sweeps (ms)", 1e3,
-                      lab_dir / "lab03_error_vs_time.png")
-    omega_figure(lab_dir, lab_dir / "lab03_omega.png")
+        return figures.skip("lab03_convergence", f"needs {lab_dir}/chain-gs.json and chain-gs/convergence.csv (and "
+                            f"the other chain-*/cloth-* runs of labs/lab03_jacobi/demo.txt); make them with: "
+                            f"./course demo --out {out_dir}")
+    sources = [path for summary in lab_dir.glob("*.json") for path in (summary, summary.with_suffix("") / "convergence.csv")]
+    for target, draw in ((lab_dir / "lab03_gs_vs_jacobi.png",
+                          lambda path: comparison_figure(lab_dir, "sweep", "sweep", 1.0, path)),
+                         (lab_dir / "lab03_error_vs_time.png",
+                          lambda path: comparison_figure(lab_dir, "total_seconds", "wall time of the sweeps (ms)",
+                                                         1e3, path)),
+                         (lab_dir / "lab03_omega.png", lambda path: omega_figure(lab_dir, path))):
+        if not figures.up_to_date(target, sources):
+            draw(target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

@@ -5,39 +5,32 @@ Reads OUTDIR/lab03_jacobi/threads-N.json and threads-N/convergence.csv
 (labs/lab03_jacobi/demo.txt) and writes lab03_threads.png next to them.
 Exit 4 when the runs are absent.
 """
-import csv
-import json
 import statistics
-import sys
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab03_jacobi"
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab03_threads.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
-    runs = []
+def main(out_dir):
+    lab_dir = out_dir / LAB
+    runs, sources = [], []
     for summary_path in lab_dir.glob("threads-*.json"):
         table_path = lab_dir / summary_path.stem / "convergence.csv"
         if table_path.is_file():
-            summary = json.loads(summary_path.read_text())
-            with open(table_path, newline="") as handle:
-                seconds = [float(row["sweep_seconds"]) for row in csv.DictReader(handle) if int(row["sweep"]) > 0]
+            seconds = [float(row["sweep_seconds"]) for row in figures.rows(table_path) if int(row["sweep"]) > 0]
             if seconds:
-                runs.append((summary, seconds))
+                runs.append((figures.summary(summary_path), seconds))
+                sources += [summary_path, table_path]
     if not runs:
-        print(f"lab03_threads: needs {lab_dir}/threads-1.json and threads-1/convergence.csv (and threads-2); "
-              f"make them with: ./course run lab03_solution --scene cloth-128 --threads 1 --iterations 200 "
-              f"--out {lab_dir}/threads-1 --summary {lab_dir}/threads-1.json (then --threads 2)", file=sys.stderr)
-        return 4
+        return figures.skip("lab03_threads", f"needs {lab_dir}/threads-1.json and threads-1/convergence.csv (and "
+                            "threads-2); make them with: " + figures.make_command(
+                                LAB, f"--scene cloth-128 --threads 1 --iterations 200 --out {lab_dir}/threads-1 "
+                                f"--summary {lab_dir}/threads-1.json (then --threads 2)"))
+    target = lab_dir / "lab03_threads.png"
+    if figures.up_to_date(target, sources):
+        return 0
     runs.sort(key=lambda run: run[0]["threads"])
 
     figure, (left, right) = plt.subplots(1, 2, figsize=(11, 4))
@@ -67,10 +60,9 @@ def main(argv):
     right.set_title("median over the sweeps, speed-up against 1 thread")
     figure.suptitle("Lab 03: time per Jacobi sweep (the positions agree bit for bit)")
     figure.tight_layout()
-    figure.savefig(lab_dir / "lab03_threads.png", dpi=120)
-    plt.close(figure)
+    figures.save(figure, target, dpi=120)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

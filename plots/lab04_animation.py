@@ -6,24 +6,18 @@ so that a GIF takes a few seconds to draw.
     plots/lab04_animation.py OUTDIR
 
 One GIF per run directory with frames: OUTDIR/lab04_pbd/<run>/animation.gif."""
-import sys
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from PIL import Image  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _lab04_mesh as mesh  # noqa: E402
+import _figures as figures
+import _lab04_mesh as mesh
+from _figures import plt
 
 MAX_FRAMES = 40
 PIXELS = 360
 DPI = 72
 
 
-def animate(run_dir):
+def animate(run_dir, target):
+    from PIL import Image
     paths = mesh.frame_paths(run_dir)
     rest = mesh.Frame(paths[0])
     frames = [mesh.Frame(p) for p in mesh.pick(paths, MAX_FRAMES)]
@@ -42,23 +36,23 @@ def animate(run_dir):
     # Real time: the simulated time between the frames shown, at least 40 ms.
     step = (frames[-1].time - frames[0].time) / max(len(frames) - 1, 1)
     duration = max(40, int(round(1000 * step)))
-    target = run_dir / "animation.gif"
     images[0].save(target, save_all=True, append_images=images[1:], duration=duration, loop=0, optimize=True)
     print(f"wrote {target} ({len(images)} frames, {duration} ms each)")
 
 
-def main(argv):
-    out_dir = argv[0] if argv else "out"
+def main(out_dir):
     runs = mesh.frame_dirs(out_dir)
     if not runs:
-        lab_dir = Path(out_dir) / mesh.LAB
-        print(f"lab04_animation: needs OBJ frames in {lab_dir}/RUN/frames/; make them with: ./course run "
-              f"lab04_solution --scene curtain-32 --iterations 16 --steps 90 --frames 2 --out {lab_dir}/curtain-32")
-        return 4
+        lab_dir = out_dir / mesh.LAB
+        return figures.skip("lab04_animation", f"needs OBJ frames in {lab_dir}/RUN/frames/; make them with: "
+                            + figures.make_command(mesh.LAB, "--scene curtain-32 --iterations 16 --steps 90 "
+                                                   f"--frames 2 --out {lab_dir}/curtain-32"))
     for run_dir in runs:
-        animate(run_dir)
+        target = run_dir / "animation.gif"
+        if not figures.up_to_date(target, mesh.frame_paths(run_dir)):
+            animate(run_dir, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))
+    figures.run(main)

@@ -11,16 +11,12 @@ import argparse
 import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _lab04_mesh as mesh  # noqa: E402
+import _figures as figures
+from _figures import plt
+import _lab04_mesh as mesh
 
 
-def snapshot(run_dir, wanted):
+def snapshot(run_dir, wanted, target):
     paths = mesh.frame_paths(run_dir)
     rest = mesh.Frame(paths[0])
     if wanted:  # the nearest written frame to each one asked for
@@ -38,10 +34,7 @@ def snapshot(run_dir, wanted):
     bar = figure.colorbar(mapper, ax=axes[0].tolist(), fraction=0.025, pad=0.02)
     bar.set_label("edge stretch |l / l0 − 1| (log)")
     figure.suptitle(f"{rest.scene}: position based dynamics (orthographic view, 1 m cloth)", fontsize=10)
-    target = run_dir / "snapshots.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
 
 
 def main(argv):
@@ -53,11 +46,13 @@ def main(argv):
     runs = mesh.frame_dirs(args.out_dir)
     if not runs:
         lab_dir = Path(args.out_dir) / mesh.LAB
-        print(f"lab04_snapshots: needs OBJ frames in {lab_dir}/RUN/frames/; make them with: ./course run "
-              f"lab04_solution --scene curtain-32 --iterations 16 --steps 90 --frames 2 --out {lab_dir}/curtain-32")
-        return 4
+        return figures.skip("lab04_snapshots", f"needs OBJ frames in {lab_dir}/RUN/frames/; make them with: "
+                            + figures.make_command(mesh.LAB, "--scene curtain-32 --iterations 16 --steps 90 "
+                                                   f"--frames 2 --out {lab_dir}/curtain-32"))
     for run_dir in runs:
-        snapshot(run_dir, wanted)
+        target = run_dir / "snapshots.png"
+        if wanted or not figures.up_to_date(target, mesh.frame_paths(run_dir)):
+            snapshot(run_dir, wanted, target)
     return 0
 
 

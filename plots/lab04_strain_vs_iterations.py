@@ -5,41 +5,31 @@ iteration count K, one curve per resolution (from `lab04_pbd
 
 Filled markers: the run settled; hollow: it had not settled when it stopped;
 a cross on the top edge: the run was unstable (the program stopped it)."""
-import csv
-import sys
 from collections import defaultdict
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab04_pbd"
 
 
-def number(text):
-    return float(text) if text not in ("", None) else None
-
-
 def read_runs(path):
     runs = defaultdict(list)
-    with open(path, newline="") as handle:
-        for row in csv.DictReader(handle):
-            runs[(int(row["particles"]), row["scene"])].append(row)
+    for row in figures.rows(path):
+        runs[(int(row["particles"]), row["scene"])].append(row)
     return dict(sorted(runs.items()))
 
 
 def draw(axes, runs, column, label, reference=False):
-    top = max((number(r[column]) or 0.0) for rows in runs.values() for r in rows) * 3.0
+    top = max((figures.number(r[column]) or 0.0) for rows in runs.values() for r in rows) * 3.0
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for index, (colour, ((_, scene), rows)) in enumerate(zip(colours, runs.items())):
         nx = rows[0]["nx"]
-        k = [int(r["iterations"]) for r in rows if number(r[column]) is not None]
-        y = [number(r[column]) for r in rows if number(r[column]) is not None]
+        k = [int(r["iterations"]) for r in rows if figures.number(r[column]) is not None]
+        y = [figures.number(r[column]) for r in rows if figures.number(r[column]) is not None]
         axes.loglog(k, y, "-", color=colour, label=f"{scene} ({nx}² particles)")
         for r in rows:
-            value = number(r[column])
+            value = figures.number(r[column])
             if value is None and r["status"].startswith("diverged"):
                 axes.plot(int(r["iterations"]), top * 1.6 ** index, "x", color=colour, ms=8, mew=2, clip_on=False)
             elif value is not None:
@@ -48,7 +38,7 @@ def draw(axes, runs, column, label, reference=False):
                           mfc=colour if settled else "white")
     if reference:  # a 1/K line through the coarsest curtain's value at K = 8
         rows = next(iter(runs.values()))
-        at_8 = [number(r[column]) for r in rows if r["iterations"] == "8" and number(r[column])]
+        at_8 = [figures.number(r[column]) for r in rows if r["iterations"] == "8" and figures.number(r[column])]
         if at_8:
             axes.loglog([1, 128], [at_8[0] * 8, at_8[0] * 8 / 128], ":", color="0.5", label="∝ 1/K")
     axes.plot([], [], "o", color="0.4", label="settled")
@@ -65,12 +55,14 @@ def draw(axes, runs, column, label, reference=False):
 
 
 def main(out_dir):
-    source = Path(out_dir) / LAB / "strain_vs_iterations.csv"
+    source = out_dir / LAB / "strain_vs_iterations.csv"
     if not source.exists():
-        print(f"lab04_strain_vs_iterations: needs {source}; make it with: ./course run lab04_solution "
-              f"--sweep-iterations 1,2,4,8,16,32,64,128 --sweep-scenes curtain-8,curtain-16,curtain-32,curtain-64 "
-              f"--steps 3600 --out {source.parent}")
-        return 4
+        return figures.skip("lab04_strain_vs_iterations", f"needs {source}; make it with: " + figures.make_command(
+            LAB, "--sweep-iterations 1,2,4,8,16,32,64,128 --sweep-scenes curtain-8,curtain-16,curtain-32,curtain-64 "
+            f"--steps 3600 --out {source.parent}"))
+    target, table = source.with_name("strain_vs_iterations.png"), source.with_name("strain_vs_iterations.md")
+    if figures.up_to_date([target, table], [source]):
+        return 0
     runs = read_runs(source)
     first = next(iter(runs.values()))[0]
     figure, (left, right) = plt.subplots(1, 2, figsize=(11.5, 5.2))
@@ -84,12 +76,8 @@ def main(out_dir):
                     f"(Δt = {float(first['dt']):.4g} s, {first['substeps']} substep, "
                     f"steady = mean over the last {float(first['window_seconds']):.3g} s)", fontsize=11)
     figure.tight_layout(rect=(0, 0.11, 1, 1))
-    target = source.with_name("strain_vs_iterations.png")
-    figure.savefig(target, dpi=120)
-    print(f"wrote {target}")
-    table = source.with_name("strain_vs_iterations.md")
-    table.write_text(markdown_table(runs))
-    print(f"wrote {table}")
+    figures.save(figure, target, dpi=120)
+    figures.write_table(table, markdown_table(runs))
     return 0
 
 
@@ -114,4 +102,4 @@ def markdown_table(runs):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

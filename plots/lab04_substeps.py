@@ -2,50 +2,43 @@
 """Lab 04, experiment 2: small steps. At a fixed cost per frame (substeps × K
 sweeps), the strain and the energy for each way of splitting the work (from
 `lab04_pbd --sweep-substeps ... --cost C`, substeps.csv)."""
-import csv
-import sys
 from collections import defaultdict
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib import transforms  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab04_pbd"
 
 
-def number(text):
-    return float(text) if text not in ("", None) else None
-
-
 def main(out_dir):
-    source = Path(out_dir) / LAB / "substeps.csv"
+    source = out_dir / LAB / "substeps.csv"
     if not source.exists():
-        print(f"lab04_substeps: needs {source}; make it with: ./course run lab04_solution --sweep-substeps "
-              f"1,2,4,8,16,32,64 --cost 64 --sweep-scenes curtain-32,rope-50 --steps 3600 --out {source.parent}")
-        return 4
+        return figures.skip("lab04_substeps", f"needs {source}; make it with: " + figures.make_command(
+            LAB, "--sweep-substeps 1,2,4,8,16,32,64 --cost 64 --sweep-scenes curtain-32,rope-50 --steps 3600 "
+            f"--out {source.parent}"))
+    target = source.with_name("substeps.png")
+    if figures.up_to_date(target, [source]):
+        return 0
+    from matplotlib import transforms
     runs = defaultdict(list)
-    with open(source, newline="") as handle:
-        for row in csv.DictReader(handle):
-            runs[row["scene"]].append(row)
+    for row in figures.rows(source):
+        runs[row["scene"]].append(row)
     first = next(iter(runs.values()))[0]
     cost = int(first["substeps"]) * int(first["iterations"])
     energy_time = float(first["energy_seconds"])
 
     figure, (left, right) = plt.subplots(1, 2, figsize=(11.5, 4.8))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    strain_top = max((number(r["steady_max_strain"]) or 0.0) for rows in runs.values() for r in rows) * 2.5
+    strain_top = max((figures.number(r["steady_max_strain"]) or 0.0) for rows in runs.values() for r in rows) * 2.5
     for index, (colour, (scene, rows)) in enumerate(zip(colours, runs.items())):
-        ok = [r for r in rows if number(r["steady_max_strain"]) is not None]
+        ok = [r for r in rows if figures.number(r["steady_max_strain"]) is not None]
         n = [int(r["substeps"]) for r in ok]
-        left.loglog(n, [number(r["steady_max_strain"]) for r in ok], "o-", color=colour, label=f"{scene}: max")
-        left.loglog(n, [number(r["steady_rms_strain"]) for r in ok], "s--", color=colour, ms=4, mfc="white",
+        left.loglog(n, [figures.number(r["steady_max_strain"]) for r in ok], "o-", color=colour, label=f"{scene}: max")
+        left.loglog(n, [figures.number(r["steady_rms_strain"]) for r in ok], "s--", color=colour, ms=4, mfc="white",
                     label=f"{scene}: RMS")
-        with_energy = [r for r in rows if number(r["energy_at_seconds"]) is not None]
+        with_energy = [r for r in rows if figures.number(r["energy_at_seconds"]) is not None]
         right.semilogx([int(r["substeps"]) for r in with_energy],
-                       [number(r["energy_at_seconds"]) - number(r["energy_start"]) for r in with_energy],
+                       [figures.number(r["energy_at_seconds"]) - figures.number(r["energy_start"]) for r in with_energy],
                        "o-", color=colour, label=scene)
         for r in rows:
             if r["status"].startswith("diverged"):
@@ -71,11 +64,9 @@ def main(out_dir):
     figure.suptitle(f"Equal cost per frame: substeps × iterations = {cost} sweeps "
                     f"(frame Δt = {float(first['dt']):.4g} s, Gauss-Seidel)", fontsize=11)
     figure.tight_layout()
-    target = source.with_name("substeps.png")
-    figure.savefig(target, dpi=120)
-    print(f"wrote {target}")
+    figures.save(figure, target, dpi=120)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -6,37 +6,25 @@ limiter's position correction becomes velocity, (x' − x̃)/Δt, which the ener
 panel shows.
 
 One PNG per run: OUTDIR/lab05_strain_limiting/<run>/history.png."""
-import csv
-import json
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab05_strain_limiting"
-COMMAND = ("./course run lab05_solution --scene stiff-curtain-32 --limit springs "
-           "--out out/lab05_strain_limiting/stiff-springs (or ./course demo)")
+COMMAND = figures.make_command(LAB, "--scene stiff-curtain-32 --limit springs "
+                               "--out out/lab05_strain_limiting/stiff-springs (or ./course demo)")
 
 
-def column(rows, name):
-    return [float(r[name]) for r in rows]
-
-
-def draw(source, summary):
-    with open(source, newline="") as handle:
-        rows = [r for r in csv.DictReader(handle) if r["status"] == "ok"]
+def draw(source, summary, target):
+    rows = figures.rows(source, ok_only=True)
     if not rows:
         return
-    time = column(rows, "time")
-    figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.0))
-    left.plot(time, column(rows, "max_strain"), label="max strain")
-    left.plot(time, column(rows, "min_strain"), label="min strain")
+    time = figures.column(rows, "time")
+    figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.6))
+    left.plot(time, figures.column(rows, "max_strain"), label="max strain")
+    left.plot(time, figures.column(rows, "min_strain"), label="min strain")
     title = source.parent.name
     if summary.exists():
-        data = json.loads(summary.read_text())
+        data = figures.summary(summary)
         if data.get("limit") != "none":
             for bound in (data.get("sigma_min"), data.get("sigma_max")):
                 left.axhline(bound - 1.0, color="k", ls="--", lw=0.8)
@@ -48,8 +36,8 @@ def draw(source, summary):
     left.set_ylabel("spring strain  l/L − 1")
     left.legend(fontsize=8)
     left.grid(True, alpha=0.3)
-    kinetic, elastic, potential = column(rows, "kinetic"), column(rows, "elastic"), column(rows, "potential")
-    total = column(rows, "total_energy")
+    kinetic, elastic, potential = figures.column(rows, "kinetic"), figures.column(rows, "elastic"), figures.column(rows, "potential")
+    total = figures.column(rows, "total_energy")
     right.plot(time, kinetic, label="kinetic")
     right.plot(time, elastic, label="elastic")
     right.plot(time, [p - potential[0] for p in potential], label="gravity − start")
@@ -58,25 +46,24 @@ def draw(source, summary):
     right.set_ylabel("energy (J)")
     if max(max(kinetic), max(elastic)) > 100 * max(min(abs(t) for t in total), 1e-12):
         right.set_yscale("symlog", linthresh=1e-2)
-    right.legend(fontsize=8)
+    # Below the panel: inside it, the legend would cover the total energy (issue 25).
+    right.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, frameon=False)
     right.grid(True, alpha=0.3)
     figure.suptitle(title, fontsize=11)
     figure.tight_layout()
-    target = source.with_name("history.png")
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
 
 
 def main(out_dir):
-    sources = sorted((Path(out_dir) / LAB).glob("*/per_step.csv"))
+    sources = sorted((out_dir / LAB).glob("*/per_step.csv"))
     if not sources:
-        print(f"lab05_history: no {Path(out_dir) / LAB}/*/per_step.csv (make one with {COMMAND})")
-        return 4
+        return figures.skip("lab05_history", f"no {out_dir / LAB}/*/per_step.csv (make one with {COMMAND})")
     for source in sources:
-        draw(source, source.parent.with_suffix(".json"))
+        summary, target = source.parent.with_suffix(".json"), source.with_name("history.png")
+        if not figures.up_to_date(target, [source, summary]):
+            draw(source, summary, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

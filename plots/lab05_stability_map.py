@@ -10,19 +10,14 @@
 
 The dashed line is the program's estimate of the explicit step's limit,
 Δt = 2 / √(8 k w). Writes stability_map.png beside the CSV."""
-import csv
 import math
-import sys
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.patches import Patch, Rectangle  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab05_strain_limiting"
-COMMAND = "./course run lab05_solution --scene map-curtain-16 --stability-map --out out/lab05_strain_limiting (or ./course demo)"
+COMMAND = figures.make_command(LAB, "--scene map-curtain-16 --stability-map --out out/lab05_strain_limiting "
+                               "(or ./course demo)")
 COLOURS = {"stable": "#5fae5f", "bounded by the limiter": "#5b8fd6", "blew up": "#d65b5b"}
 
 
@@ -36,12 +31,14 @@ def edges(values):
 
 
 def main(out_dir):
-    source = Path(out_dir) / LAB / "stability_map.csv"
+    source = out_dir / LAB / "stability_map.csv"
     if not source.is_file():
-        print(f"lab05_stability_map: no {source} (make it with {COMMAND})")
-        return 4
-    with open(source, newline="") as handle:
-        rows = list(csv.DictReader(handle))
+        return figures.skip("lab05_stability_map", f"no {source} (make it with {COMMAND})")
+    target = source.with_name("stability_map.png")
+    if figures.up_to_date(target, [source]):
+        return 0
+    from matplotlib.patches import Patch, Rectangle
+    rows = figures.rows(source)
     dts = sorted({float(r["dt"]) for r in rows})
     stiffnesses = sorted({float(r["stiffness"]) for r in rows})
     dt_edges, k_edges = edges(dts), edges(stiffnesses)
@@ -77,12 +74,9 @@ def main(out_dir):
     handles.append(axis.get_lines()[0])
     axis.legend(handles=handles, fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     figure.tight_layout()
-    target = source.with_name("stability_map.png")
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -8,27 +8,15 @@
 - shapes.png — the curtain after the run, every spring coloured by its strain.
 
 Input: OUTDIR/lab05_strain_limiting/{strain_vs_time,compare_limits,shapes}.csv."""
-import csv
-import sys
 from collections import defaultdict
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.collections import LineCollection  # noqa: E402
-from matplotlib.colors import TwoSlopeNorm  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab05_strain_limiting"
-COMMAND = ("./course run lab05_solution --scene soft-curtain-32 "
-           "--compare-limits none,springs,triangles-area,triangles-stretch --steps 800 --out out/lab05_strain_limiting"
-           " (or ./course demo)")
-
-
-def read(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COMMAND = figures.make_command(LAB, "--scene soft-curtain-32 --compare-limits "
+                               "none,springs,triangles-area,triangles-stretch --steps 800 "
+                               "--out out/lab05_strain_limiting (or ./course demo)")
 
 
 def draw_strain(series, table, target):
@@ -66,12 +54,12 @@ def draw_strain(series, table, target):
     right.set_title("cost per step (label: max strain over the run)", fontsize=10)
     right.grid(True, axis="y", which="both", alpha=0.3)
     figure.tight_layout()
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
 
 
 def draw_shapes(shapes, table, target):
+    from matplotlib.collections import LineCollection
+    from matplotlib.colors import TwoSlopeNorm
     by_limit = defaultdict(list)
     for row in shapes:
         by_limit[row["limit"]].append(row)
@@ -100,23 +88,21 @@ def draw_shapes(shapes, table, target):
     figure.colorbar(collection, ax=axes[0].tolist(), extend="both",
                     label=f"strain l/L − 1 (band up to {sigma_max - 1:g})")
     figure.suptitle(f"{table[0]['scene']} after {float(table[0]['dt']) * int(table[0]['steps_done']):g} s", fontsize=10)
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
 
 
 def main(out_dir):
-    folder = Path(out_dir) / LAB
+    folder = out_dir / LAB
     paths = [folder / "strain_vs_time.csv", folder / "compare_limits.csv", folder / "shapes.csv"]
     for path in paths:
         if not path.is_file():
-            print(f"lab05_strain_vs_time: no {path} (make it with {COMMAND})")
-            return 4
-    series, table, shapes = (read(path) for path in paths)
-    draw_strain(series, table, folder / "strain_vs_time.png")
-    draw_shapes(shapes, table, folder / "shapes.png")
+            return figures.skip("lab05_strain_vs_time", f"no {path} (make it with {COMMAND})")
+    if not figures.up_to_date(folder / "strain_vs_time.png", paths[:2]):
+        draw_strain(figures.rows(paths[0]), figures.rows(paths[1]), folder / "strain_vs_time.png")
+    if not figures.up_to_date(folder / "shapes.png", paths[1:]):
+        draw_shapes(figures.rows(paths[2]), figures.rows(paths[1]), folder / "shapes.png")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

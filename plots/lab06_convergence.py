@@ -8,19 +8,12 @@ and writes next to each CSV, per scene:
                             and against wall time (right), log scales
 Exit 4 when the data are absent.
 """
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab06_projective_dynamics"
-COMMAND = ("./course run lab06_solution --convergence --sweep-scenes "
-           "pd-curtain-16,pd-curtain-32,pd-curtain-64,pd-curtain-128 --out out/lab06_projective_dynamics "
-           "(or ./course demo)")
+COMMAND = figures.make_command(LAB, "--convergence --sweep-scenes pd-curtain-16,pd-curtain-32,pd-curtain-64,"
+                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo)")
 FLOOR = 1e-17  # an error of exactly 0 (the reference itself) is drawn here
 STYLE = {"pd": {"color": "tab:blue", "label": "projective dynamics (1 factorization)"},
          "newton": {"color": "tab:red", "marker": "o", "markersize": 3,
@@ -31,9 +24,8 @@ TARGETS = (1e-2, 1e-3, 1e-6)
 def read_runs(path):
     """{scene: {method: [rows]}} from a convergence.csv."""
     runs = {}
-    with open(path, newline="") as handle:
-        for row in csv.DictReader(handle):
-            runs.setdefault(row["scene"], {}).setdefault(row["method"], []).append(row)
+    for row in figures.rows(path):
+        runs.setdefault(row["scene"], {}).setdefault(row["method"], []).append(row)
     return runs
 
 
@@ -66,26 +58,22 @@ def draw(scene, methods, path):
     figure.suptitle(f"Lab 06: one implicit-Euler step of {scene}, {first['unknowns']} unknowns{note}; "
                     f"zero error drawn at {FLOOR:g}")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab06_convergence.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
+def main(out_dir):
+    lab_dir = out_dir / LAB
     tables = [path for path in (lab_dir / "convergence.csv", lab_dir / "wrinkled" / "convergence.csv")
               if path.is_file()]
     if not tables:
-        print(f"lab06_convergence: {lab_dir / 'convergence.csv'} is missing; make it with {COMMAND}",
-              file=sys.stderr)
-        return 4
+        return figures.skip("lab06_convergence", f"{lab_dir / 'convergence.csv'} is missing; make it with {COMMAND}")
     for table in tables:
         for scene, methods in read_runs(table).items():
-            draw(scene, methods, table.parent / f"convergence_{scene}.png")
+            target = table.parent / f"convergence_{scene}.png"
+            if not figures.up_to_date(target, [table]):
+                draw(scene, methods, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

@@ -8,27 +8,18 @@ labs/lab06_projective_dynamics/demo.txt) and writes next to it:
   crossover.md    the same numbers as a table, with iterations and factorizations
 Exit 4 when the data are absent.
 """
-import csv
-import sys
-from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab06_projective_dynamics"
-COMMAND = ("./course run lab06_solution --convergence --sweep-scenes "
-           "pd-curtain-16,pd-curtain-32,pd-curtain-64,pd-curtain-128 --out out/lab06_projective_dynamics "
-           "(or ./course demo)")
-
-
-def read_rows(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COMMAND = figures.make_command(LAB, "--convergence --sweep-scenes pd-curtain-16,pd-curtain-32,pd-curtain-64,"
+                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo)")
 
 
 def figure(rows, path):
+    from matplotlib import transforms
+    from matplotlib.lines import Line2D
     targets = sorted({float(row["target"]) for row in rows}, reverse=True)
     plot, axes = plt.subplots(1, len(targets), figsize=(5 * len(targets), 4.5), squeeze=False)
     for axis, target in zip(axes[0], targets):
@@ -44,20 +35,22 @@ def figure(rows, path):
                             marker=marker, color=color, linestyle=":", fillstyle="none",
                             label="pd, factorization amortised")
             missing.extend((row, color) for row in chosen if row["reached"] != "yes")
-        top = axis.get_ylim()[1]
-        for row, color in missing:
-            axis.annotate(f"{row['method']}: " + ("not reached" if row["reached"] == "no" else "undecided"),
-                          (int(row["unknowns"]), top), color=color, fontsize=7, rotation=90, va="top",
-                          ha="center")
-        axis.set_title(f"(g - g*)/g* <= {target:g}")
-        axis.set_xlabel("unknowns (movable particles)")
-        axis.set_ylabel("wall time of the step (s)")
-        axis.grid(True, which="major", alpha=0.3)
-        axis.legend(fontsize=7)
-    plot.suptitle("Lab 06: time to an accuracy, one step of the curtains (labels: runs that did not get there)")
-    plot.tight_layout()
-    plot.savefig(path, dpi=120)
-    plt.close(plot)
+        # Runs that did not get there: a marker on the top edge, above the data
+        # (inside the panel, labels covered the points and the legend, issue 25).
+        edge = transforms.blended_transform_factory(axis.transData, axis.transAxes)
+        for row, color in missing:  # side by side where both methods miss at one size
+            axis.plot(int(row["unknowns"]) * (0.93 if row["method"] == "pd" else 1.07), 1.0, marker="x" if row["reached"] == "no" else "$?$", ls="",
+                      color=color, ms=9, mew=2, clip_on=False, transform=edge)
+        axis.set_title(f"(g - g*)/g* <= {target:g}", pad=12)
+        figures.finish(axis, "unknowns (movable particles)", "wall time of the step (s)", legend=None)
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    handles += [Line2D([], [], color="0.3", marker="x", mew=2, ls=""),
+                Line2D([], [], color="0.3", marker="$?$", ms=9, ls="")]
+    labels += ["not reached (on the top edge)", "undecided (on the top edge)"]
+    plot.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
+    plot.suptitle("Lab 06: time to an accuracy, one step of the curtains")
+    plot.tight_layout(rect=(0, 0.07, 1, 1))
+    figures.save(plot, path, dpi=120)
 
 
 def table(rows, path):
@@ -80,22 +73,19 @@ def table(rows, path):
     path.write_text("\n".join(lines) + "\n")
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab06_crossover.py OUTDIR", file=sys.stderr)
-        return 2
-    source = Path(argv[1]) / LAB / "crossover.csv"
+def main(out_dir):
+    source = out_dir / LAB / "crossover.csv"
     if not source.is_file():
-        print(f"lab06_crossover: {source} is missing; make it with {COMMAND}", file=sys.stderr)
-        return 4
-    rows = read_rows(source)
-    figure(rows, source.parent / "crossover.png")
-    table(rows, source.parent / "crossover.md")
+        return figures.skip("lab06_crossover", f"{source} is missing; make it with {COMMAND}")
+    if not figures.up_to_date([source.parent / "crossover.png", source.parent / "crossover.md"], [source]):
+        rows = figures.rows(source)
+        figure(rows, source.parent / "crossover.png")
+        table(rows, source.parent / "crossover.md")
     wrinkled = source.parent / "wrinkled" / "crossover.csv"
-    if wrinkled.is_file():
-        table(read_rows(wrinkled), wrinkled.parent / "crossover.md")
+    if wrinkled.is_file() and not figures.up_to_date(wrinkled.parent / "crossover.md", [wrinkled]):
+        table(figures.rows(wrinkled), wrinkled.parent / "crossover.md")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

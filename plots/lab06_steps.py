@@ -6,24 +6,12 @@ labs/lab06_projective_dynamics/demo.txt) and writes <run>/steps.png: the step's
 final objective, its iterations and wall time, and the max strain, against time.
 Exit 4 when no run is there.
 """
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab06_projective_dynamics"
-COMMAND = ("./course run lab06_solution --scene pd-curtain-32 --out out/lab06_projective_dynamics/curtain-32-pd "
-           "(or ./course demo)")
-
-
-def read(path):
-    with open(path, newline="") as handle:
-        rows = [row for row in csv.DictReader(handle) if int(row["step"]) > 0]
-    return rows
+COMMAND = figures.make_command(LAB, "--scene pd-curtain-32 --out out/lab06_projective_dynamics/curtain-32-pd "
+                               "(or ./course demo)")
 
 
 def draw(rows, title, path):
@@ -46,25 +34,22 @@ def draw(rows, title, path):
     bad = [row for row in rows if row["status"] != "ok"]
     figure.suptitle(title + (f" — {bad[0]['status']}" if bad else ""))
     figure.tight_layout()
-    figure.savefig(path, dpi=110)
-    plt.close(figure)
+    figures.save(figure, path)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab06_steps.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
+def main(out_dir):
+    lab_dir = out_dir / LAB
     runs = sorted(lab_dir.glob("*/per_step.csv"))
     if not runs:
-        print(f"lab06_steps: no {lab_dir}/<run>/per_step.csv; make one with {COMMAND}", file=sys.stderr)
-        return 4
+        return figures.skip("lab06_steps", f"no {lab_dir}/<run>/per_step.csv; make one with {COMMAND}")
     for table in runs:
-        rows = read(table)
+        if figures.up_to_date(table.parent / "steps.png", [table]):
+            continue
+        rows = [row for row in figures.rows(table) if int(row["step"]) > 0]
         if rows:
             draw(rows, f"Lab 06: {table.parent.name}, per step", table.parent / "steps.png")
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)

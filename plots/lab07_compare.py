@@ -6,30 +6,22 @@ K = 1 ... 256 sweeps and with n substeps of one sweep, and this lab's Schur and
 KKT steps (with and without the post-step projection) with n substeps.
 
 Reads OUTDIR/lab07_constrained_dynamics/compare.csv, writes compare.png beside it."""
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab07_constrained_dynamics"
 MAKE = ("./course demo   (or: ./course run lab07 --scene ragdoll-chain-20 --compare-pbd 1,2,4,8,16,32,64,128,256 "
         "--compare-substeps 1,2,4,8,16,32 --out OUT/lab07_constrained_dynamics)")
 
 
-def main():
-    if len(sys.argv) != 2:
-        print(f"usage: {Path(sys.argv[0]).name} OUTDIR", file=sys.stderr)
-        return 2
-    source = Path(sys.argv[1]) / LAB / "compare.csv"
+def main(out_dir):
+    source = out_dir / LAB / "compare.csv"
     if not source.is_file():
-        print(f"{source}: missing; make it with {MAKE}", file=sys.stderr)
-        return 4
-    with open(source, newline="") as handle:
-        rows = [r for r in csv.DictReader(handle) if r["status"] == "ok"]
+        return figures.skip("lab07_compare", f"{source}: missing; make it with {MAKE}")
+    target = source.parent / "compare.png"
+    if figures.up_to_date(target, [source]):
+        return 0
+    rows = figures.rows(source, ok_only=True)
     series = {}
     for r in rows:
         if r["method"].startswith("pbd"):
@@ -60,11 +52,9 @@ def main():
     axes.grid(True, which="both", alpha=0.3)
     axes.legend(fontsize=8)
     figure.tight_layout()
-    target = source.parent / "compare.png"
-    figure.savefig(target, dpi=110)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    figures.run(main)

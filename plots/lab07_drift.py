@@ -7,14 +7,8 @@ per simulated second of each run, split into the solve and the projection.
 
 Reads OUTDIR/lab07_constrained_dynamics/{drift,drift-stabilized,drift-dt4}/per_frame.csv
 and writes drift.png beside them."""
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab07_constrained_dynamics"
 RUNS = [
@@ -26,21 +20,19 @@ MAKE = ("./course demo   (or: ./course run lab07 --scene ragdoll-chain-20 [--sta
         "--dt 0.004166666666666667 --steps 1200] --out OUT/lab07_constrained_dynamics/RUN)")
 
 
-def main():
-    if len(sys.argv) != 2:
-        print(f"usage: {Path(sys.argv[0]).name} OUTDIR", file=sys.stderr)
-        return 2
-    folder = Path(sys.argv[1]) / LAB
-    for run, _ in RUNS:
-        source = folder / run / "per_frame.csv"
+def main(out_dir):
+    folder = out_dir / LAB
+    sources = [folder / run / "per_frame.csv" for run, _ in RUNS]
+    for source in sources:
         if not source.is_file():
-            print(f"{source}: missing; make it with {MAKE}", file=sys.stderr)
-            return 4
+            return figures.skip("lab07_drift", f"{source}: missing; make it with {MAKE}")
+    target = folder / "drift.png"
+    if figures.up_to_date(target, sources):
+        return 0
     figure, (left, right) = plt.subplots(1, 2, figsize=(12.0, 4.2), gridspec_kw={"width_ratios": [2, 1]})
     names, solve_ms, projection_ms = [], [], []
     for run, label in RUNS:
-        with open(folder / run / "per_frame.csv", newline="") as handle:
-            rows = [r for r in csv.DictReader(handle) if r["status"] == "ok" and int(r["frame"]) > 0]
+        rows = [r for r in figures.rows(folder / run / "per_frame.csv", ok_only=True) if int(r["frame"]) > 0]
         time = [float(r["time"]) for r in rows]
         error = [max(float(r["max_constraint_error"]), 1e-17) for r in rows]
         left.semilogy(time, error, lw=1.2, label=f"{label}: worst {max(error):.2g} m")
@@ -62,11 +54,9 @@ def main():
     right.set_title("cost")
     right.legend(fontsize=8)
     figure.tight_layout()
-    target = folder / "drift.png"
-    figure.savefig(target, dpi=110)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    figures.run(main)

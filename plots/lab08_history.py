@@ -4,55 +4,37 @@ DIR`) — the total stretch and the energies — and, from the run's summary, th
 multipliers of the last substep per spring (λ/Δt², N; negative = tension).
 
 One PNG per run: OUTDIR/lab08_xpbd/<run>/history.png."""
-import csv
-import json
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab08_xpbd"
 
 
-def column(rows, name):
-    return [float(r[name]) for r in rows]
-
-
-def draw(source, summary_path):
-    with open(source, newline="") as handle:
-        rows = [r for r in csv.DictReader(handle) if r["status"] == "ok"]
-    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+def draw(source, summary_path, target):
+    from matplotlib.ticker import MaxNLocator
+    rows = figures.rows(source, ok_only=True)
+    summary = figures.summary(summary_path)
     multipliers = summary.get("multipliers")
     panels = 3 if multipliers else 2
     figure, axes = plt.subplots(1, panels, figsize=(5.0 * panels, 4.0))
-    time = column(rows, "time")
+    time = figures.column(rows, "time")
 
     stretch = axes[0]
-    stretch.plot(time, [1e3 * s for s in column(rows, "total_stretch")], label="total stretch Σ(ℓ − L)")
+    stretch.plot(time, [1e3 * s for s in figures.column(rows, "total_stretch")], label="total stretch Σ(ℓ − L)")
     if "hanging_chain_stretch" in summary:
         stretch.axhline(1e3 * summary["hanging_chain_stretch"], color="k", ls="--", lw=1,
                         label="hanging at rest with its springs' k")
-    stretch.set_xlabel("time (s)")
-    stretch.set_ylabel("stretch (mm)")
-    stretch.legend(fontsize=8)
-    stretch.grid(True, alpha=0.3)
+    figures.finish(stretch, "time (s)", "stretch (mm)")
 
     energy = axes[1]
-    kinetic, potential = column(rows, "kinetic"), column(rows, "potential")
-    elastic, total = column(rows, "elastic"), column(rows, "total_energy")
+    kinetic, potential = figures.column(rows, "kinetic"), figures.column(rows, "potential")
+    elastic, total = figures.column(rows, "elastic"), figures.column(rows, "total_energy")
     energy.plot(time, [k - kinetic[0] for k in kinetic], label="kinetic − start")
     energy.plot(time, [p - potential[0] for p in potential], label="gravitational − start")
     if any(e != 0.0 for e in elastic):
         energy.plot(time, [e - elastic[0] for e in elastic], label="elastic ½k(ℓ − L)² − start")
     energy.plot(time, [e - total[0] for e in total], "k", lw=2, label="total − start")
-    energy.set_xlabel("time (s)")
-    energy.set_ylabel("energy change (J)")
-    energy.legend(fontsize=8)
-    energy.grid(True, alpha=0.3)
+    figures.finish(energy, "time (s)", "energy change (J)")
 
     if multipliers:
         bars = axes[2]
@@ -72,24 +54,22 @@ def draw(source, summary_path):
             title += f" — unstable at frame {summary.get('diverged_at_frame')}"
     figure.suptitle(title, fontsize=11)
     figure.tight_layout()
-    target = source.with_name("history.png")
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
 
 
 def main(out_dir):
-    lab_dir = Path(out_dir) / LAB
+    lab_dir = out_dir / LAB
     sources = sorted(lab_dir.glob("*/per_frame.csv"))
     if not sources:
-        print(f"lab08_history: needs {lab_dir}/RUN/per_frame.csv; make it with: ./course run lab08_solution "
-              f"--scene hanging-chain-20 --iterations 512 --out {lab_dir}/hanging-chain-20 "
-              f"--summary {lab_dir}/hanging-chain-20.json")
-        return 4
+        return figures.skip("lab08_history", f"needs {lab_dir}/RUN/per_frame.csv; make it with: " + figures.make_command(
+            LAB, f"--scene hanging-chain-20 --iterations 512 --out {lab_dir}/hanging-chain-20 "
+            f"--summary {lab_dir}/hanging-chain-20.json"))
     for source in sources:
-        draw(source, source.parent.with_suffix(".json"))
+        summary, target = source.parent.with_suffix(".json"), source.with_name("history.png")
+        if not figures.up_to_date(target, [source, summary]):
+            draw(source, summary, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

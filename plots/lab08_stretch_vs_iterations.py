@@ -9,42 +9,27 @@ shows relative to its material's, k_eff/k = material stretch / steady stretch.
 Filled markers: the run settled; hollow: it had not when it stopped; a cross
 on the top edge: the program reported it unstable. Also writes the table of
 the handout as stretch_vs_iterations.md."""
-import csv
-import sys
-from pathlib import Path
-
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab08_xpbd"
 METHODS = ("pbd", "xpbd")
-COMMAND = ("./course run lab08_solution --sweep-iterations 1,2,4,8,16,32,64,128,256,512,1024 "
-           "--method {method} --steps 3600 --out {out}")
-
-
-def number(text):
-    return float(text) if text not in ("", None) else None
-
-
-def read(path):
-    with open(path, newline="") as handle:
-        return list(csv.DictReader(handle))
+COMMAND = figures.make_command(LAB, "--sweep-iterations 1,2,4,8,16,32,64,128,256,512,1024 "
+                               "--method {method} --steps 3600 --out {out}")
 
 
 def draw(axes, runs, column, label):
-    values = [number(r[column]) for rows in runs.values() for r in rows if number(r[column])]
+    values = [figures.number(r[column]) for rows in runs.values() for r in rows if figures.number(r[column])]
     top = max(values) * 3.0
     styles = {"pbd": ("C0", "PBD (lab 04: every spring a hard constraint)"),
               "xpbd": ("C3", "XPBD (compliance 1/k)")}
     for index, (method, rows) in enumerate(runs.items()):
         colour, name = styles[method]
-        k = [int(r["iterations"]) for r in rows if number(r[column])]
-        y = [number(r[column]) for r in rows if number(r[column])]
+        k = [int(r["iterations"]) for r in rows if figures.number(r[column])]
+        y = [figures.number(r[column]) for r in rows if figures.number(r[column])]
         axes.loglog(k, y, "-", color=colour, label=name)
         for r in rows:
-            value = number(r[column])
+            value = figures.number(r[column])
             if value is None and r["status"].startswith("diverged"):
                 axes.plot(int(r["iterations"]), top * 1.6 ** index, "x", color=colour, ms=8, mew=2, clip_on=False)
             elif value:
@@ -60,17 +45,18 @@ def draw(axes, runs, column, label):
 
 
 def main(out_dir):
-    lab_dir = Path(out_dir) / LAB
-    runs = {}
-    for method in METHODS:
-        source = lab_dir / f"stretch_vs_iterations_{method}.csv"
+    lab_dir = out_dir / LAB
+    sources = [lab_dir / f"stretch_vs_iterations_{method}.csv" for method in METHODS]
+    for method, source in zip(METHODS, sources):
         if not source.exists():
-            print(f"lab08_stretch_vs_iterations: needs {source}; make it with: "
-                  + COMMAND.format(method=method, out=lab_dir))
-            return 4
-        runs[method] = read(source)
+            return figures.skip("lab08_stretch_vs_iterations", f"needs {source}; make it with: "
+                                + COMMAND.format(method=method, out=lab_dir))
+    target, table = lab_dir / "stretch_vs_iterations.png", lab_dir / "stretch_vs_iterations.md"
+    if figures.up_to_date([target, table], sources):
+        return 0
+    runs = {method: figures.rows(source) for method, source in zip(METHODS, sources)}
     first = runs["xpbd"][0]
-    material = number(first["material_total_stretch"])
+    material = figures.number(first["material_total_stretch"])
     figure, (left, right) = plt.subplots(1, 2, figsize=(11.5, 5.0))
     draw(left, runs, "steady_total_stretch", "steady total stretch (m)")
     if material:
@@ -88,12 +74,8 @@ def main(out_dir):
     figure.suptitle(f"{first['scene']}: PBD's stiffness moves with K, XPBD's converges to the material's "
                     f"(Δt = {float(first['dt']):.4g} s, {first['substeps']} substep)", fontsize=11)
     figure.tight_layout()
-    target = lab_dir / "stretch_vs_iterations.png"
-    figure.savefig(target, dpi=120)
-    print(f"wrote {target}")
-    table = lab_dir / "stretch_vs_iterations.md"
-    table.write_text(markdown_table(runs))
-    print(f"wrote {table}")
+    figures.save(figure, target, dpi=120)
+    figures.write_table(table, markdown_table(runs))
     return 0
 
 
@@ -111,7 +93,7 @@ def markdown_table(runs):
             elif row["status"].startswith("diverged"):
                 cells.append("unstable")
             else:
-                ratio = number(row["stiffness_ratio"])
+                ratio = figures.number(row["stiffness_ratio"])
                 cell = f"{float(row['steady_total_stretch']):.4g} m"
                 if ratio:
                     cell += f" ({ratio:.3g})"
@@ -121,4 +103,4 @@ def markdown_table(runs):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -8,22 +8,14 @@ driver's 2/omega_max, where symplectic Euler on the chain's sideways
 vibrations stops being stable.
 
 Writes OUTDIR/lab09_stable_constrained/stability.png."""
-import csv
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab09_stable_constrained"
 COMMAND = "./course demo (or ./course run lab09 --sweep-mass-ratios 1,10,100,1000,10000,100000,1000000 --out out/lab09_stable_constrained)"
 STYLE = {"off": ("tab:red", "without K_g (lab 07)"), "on": ("tab:blue", "with K_g")}
-
-
-def number(text):
-    return float(text) if text not in ("", None) else None
 
 
 def main(out_dir):
@@ -31,24 +23,24 @@ def main(out_dir):
     limits_path, runs_path = folder / "stability.csv", folder / "stability_runs.csv"
     for path in (limits_path, runs_path):
         if not path.exists():
-            print(f"lab09_stability: no {path} (make it with {COMMAND})")
-            return 4
-    with open(limits_path, newline="") as handle:
-        limits = list(csv.DictReader(handle))
-    with open(runs_path, newline="") as handle:
-        runs = list(csv.DictReader(handle))
+            return figures.skip("lab09_stability", f"no {path} (make it with {COMMAND})")
+    limits, runs = figures.rows(limits_path), figures.rows(runs_path)
     if not limits:
-        print(f"lab09_stability: {limits_path} has no rows (make it with {COMMAND})")
-        return 4
+        return figures.skip("lab09_stability", f"{limits_path} has no rows (make it with {COMMAND})")
+    target = folder / "stability.png"
+    if figures.up_to_date(target, [limits_path, runs_path]):
+        return 0
+    from matplotlib.lines import Line2D
 
-    figure, axes = plt.subplots(figsize=(7.5, 5.0))
+    figure, axes = plt.subplots(figsize=(7.5, 5.8))
+    arrows = []
     offsets = {"off": 0.93, "on": 1.07}  # side by side, so both modes' markers show
     for mode, (colour, label) in STYLE.items():
         rows = [r for r in limits if r["geometric_stiffness"] == mode]
         if not rows:
             continue
         ratio = [float(r["mass_ratio"]) for r in rows]
-        largest = [number(r["largest_stable_dt"]) for r in rows]
+        largest = [figures.number(r["largest_stable_dt"]) for r in rows]
         points = [(x, y) for x, y in zip(ratio, largest) if y is not None]
         if points:
             axes.loglog(*zip(*points), "-", color=colour, lw=2, label=f"largest stable Δt, {label}")
@@ -57,9 +49,9 @@ def main(out_dir):
                  if y is not None and r["first_unstable_dt"] == ""]
         for x, y in never:
             axes.annotate("", xy=(x, y * 1.6), xytext=(x, y), arrowprops={"arrowstyle": "->", "color": colour})
-        if never:
-            axes.text(never[0][0], never[0][1] * 0.75, "no unstable Δt up to the largest tried", color=colour,
-                      fontsize=8, va="top")
+        if never:  # in the legend: over the plot, the words covered the markers (issue 25)
+            arrows.append((Line2D([], [], color=colour, marker="$\\uparrow$", ms=10, ls=""),
+                           f"no unstable Δt up to the largest tried, {label}"))
         tried = [r for r in runs if r["geometric_stiffness"] == mode]
         stable = [(float(r["mass_ratio"]) * offsets[mode], float(r["dt"])) for r in tried if r["stable"] == "1"]
         unstable = [(float(r["mass_ratio"]) * offsets[mode], float(r["dt"])) for r in tried if r["stable"] != "1"]
@@ -75,14 +67,15 @@ def main(out_dir):
     axes.set_title(f"heavy chain, {first['links']} hard links, {first['steps']} steps per run, "
                    f"method {first['method']}", fontsize=10)
     axes.grid(True, which="both", alpha=0.3)
-    axes.legend(fontsize=8, loc="lower left")
+    handles, labels = axes.get_legend_handles_labels()
+    handles += [handle for handle, _ in arrows]
+    labels += [text for _, text in arrows]
+    axes.legend(handles, labels, fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2,
+                frameon=False)
     figure.tight_layout()
-    target = folder / "stability.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

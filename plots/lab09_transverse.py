@@ -6,16 +6,11 @@ scene are drawn together, so the geometric stiffness on and off sit side by
 side; a run that stopped ends where it stopped (marked x).
 
 Writes OUTDIR/lab09_stable_constrained/transverse-<scene>.png per scene."""
-import csv
-import json
-import sys
 from collections import defaultdict
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab09_stable_constrained"
 COMMAND = "./course demo (or ./course run lab09 --scene heavy-chain-1000 --out out/lab09_stable_constrained/heavy-chain-1000-on)"
@@ -23,24 +18,23 @@ FLOOR = 1e-17  # log axes: exact zeros drawn here
 
 
 def load(source):
-    with open(source, newline="") as handle:
-        rows = list(csv.DictReader(handle))
-    summary_path = source.parent.with_suffix(".json")
-    summary = json.loads(summary_path.read_text()) if summary_path.exists() else {}
-    return rows, summary
+    return figures.rows(source), figures.summary(source.parent.with_suffix(".json"))
 
 
 def main(out_dir):
     folder = Path(out_dir) / LAB
     sources = sorted(folder.glob("*/per_frame.csv"))
     if not sources:
-        print(f"lab09_transverse: no {folder}/*/per_frame.csv (make them with {COMMAND})")
-        return 4
-    by_scene = defaultdict(list)
+        return figures.skip("lab09_transverse", f"no {folder}/*/per_frame.csv (make them with {COMMAND})")
+    by_scene, inputs = defaultdict(list), defaultdict(list)
     for source in sources:
         rows, summary = load(source)
         by_scene[summary.get("scene", source.parent.name)].append((source.parent.name, rows, summary))
+        inputs[summary.get("scene", source.parent.name)] += [source, source.parent.with_suffix(".json")]
     for scene, runs in sorted(by_scene.items()):
+        target = folder / f"transverse-{scene}.png"
+        if figures.up_to_date(target, inputs[scene]):
+            continue
         figure, (left, right) = plt.subplots(1, 2, figsize=(11.0, 4.0))
         for name, rows, summary in runs:
             finite = [r for r in rows if r["max_transverse_speed"] not in ("", "nan", "inf")]
@@ -70,12 +64,9 @@ def main(out_dir):
         figure.suptitle(f"{scene}" + (f", Δt = {dt:.4g} s" if dt else "") + "  (x: the run stopped there)",
                         fontsize=11)
         figure.tight_layout()
-        target = folder / f"transverse-{scene}.png"
-        figure.savefig(target, dpi=110)
-        plt.close(figure)
-        print(f"wrote {target}")
+        figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

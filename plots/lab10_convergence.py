@@ -6,28 +6,19 @@ in OUTDIR/lab10_hierarchical_pbd/ and its curtain-128/ folder).
 
 Writes convergence.png (the curves), to_target.png (projections to 5 % and
 1 % against the resolution) and to_target.md (the table for the handout)."""
-import csv
-import sys
 from collections import defaultdict
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: ./course run lab10_solution --converge --sweep-scenes flat-curtain-32,flat-curtain-64 "
-           "--sweep-levels 1,2,3,4 --iterations-per-level 4 --out out/lab10_hierarchical_pbd)")
+COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--converge --sweep-scenes flat-curtain-32,flat-curtain-64 "
+           "--sweep-levels 1,2,3,4 --iterations-per-level 4 --out out/lab10_hierarchical_pbd)"))
 
 
 def read(paths):
-    rows = []
-    for path in paths:
-        if path.exists():
-            with open(path, newline="") as handle:
-                rows.extend(csv.DictReader(handle))
-    return rows
+    return [row for path in paths if path.exists() for row in figures.rows(path)]
 
 
 def level_label(levels):
@@ -59,9 +50,7 @@ def draw_curves(samples, targets, target_path):
     figure.suptitle("One step of the released curtain: convergence of the projection, flat GS against "
                     "hierarchical PBD", fontsize=11)
     figure.tight_layout(rect=(0, 0, 1, 0.95))
-    figure.savefig(target_path, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target_path}")
+    figures.save(figure, target_path)
 
 
 def draw_to_target(reached, target_path):
@@ -94,9 +83,7 @@ def draw_to_target(reached, target_path):
         panel.legend(fontsize=8)
     figure.suptitle("Cost of one step's projection to a strain target (4 sweeps per level and pass)", fontsize=11)
     figure.tight_layout(rect=(0, 0, 1, 0.94))
-    figure.savefig(target_path, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target_path}")
+    figures.save(figure, target_path)
 
 
 def markdown(reached):
@@ -121,17 +108,16 @@ def main(out_dir):
     sample_paths = [lab_dir / "convergence.csv", lab_dir / "curtain-128" / "convergence.csv"]
     target_paths = [lab_dir / "to_target.csv", lab_dir / "curtain-128" / "to_target.csv"]
     if not sample_paths[0].exists() or not target_paths[0].exists():
-        print(f"lab10_convergence: no {sample_paths[0]} or {target_paths[0]}; make them with {COMMAND}")
-        return 4
+        return figures.skip("lab10_convergence", f"no {sample_paths[0]} or {target_paths[0]}; make them with {COMMAND}")
     samples, reached = read(sample_paths), read(target_paths)
     targets = sorted({float(r["target"]) for r in reached})
-    draw_curves(samples, targets, lab_dir / "convergence.png")
-    draw_to_target(reached, lab_dir / "to_target.png")
-    table = lab_dir / "to_target.md"
-    table.write_text(markdown(reached))
-    print(f"wrote {table}")
+    if not figures.up_to_date(lab_dir / "convergence.png", sample_paths + target_paths):
+        draw_curves(samples, targets, lab_dir / "convergence.png")
+    if not figures.up_to_date([lab_dir / "to_target.png", lab_dir / "to_target.md"], target_paths):
+        draw_to_target(reached, lab_dir / "to_target.png")
+        figures.write_table(lab_dir / "to_target.md", markdown(reached))
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

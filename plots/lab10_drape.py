@@ -2,28 +2,26 @@
 """Lab 10: the drape at equal cost, flat Gauss-Seidel (top row) against three
 levels (bottom row), coloured by how far each edge is stretched (from the OBJ
 frames of the `drape-levels-N` runs of the demo). Writes drape.png."""
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import _lab04_mesh as mesh  # noqa: E402  (the OBJ reader and the camera of lab 04's pictures)
+import _figures as figures
+from _figures import plt
+import _lab04_mesh as mesh  # the OBJ reader and the camera of lab 04's pictures
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: ./course run lab10_solution --scene drape-32 --levels 3 --iterations-per-level 12 "
-           "--steps 150 --frames 15 --out out/lab10_hierarchical_pbd/drape-levels-3)")
+COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--scene drape-32 --levels 3 --iterations-per-level 12 "
+                                                      "--steps 150 --frames 15 "
+                                                      "--out out/lab10_hierarchical_pbd/drape-levels-3") + ")")
 
 
 def main(out_dir):
     lab_dir = Path(out_dir) / LAB
     runs = [d for d in sorted(lab_dir.glob("drape-levels-*")) if mesh.frame_paths(d)]
     if not runs:
-        print(f"lab10_drape: no OBJ frames in {lab_dir}/drape-levels-N/frames/; make them with {COMMAND}")
-        return 4
+        return figures.skip("lab10_drape", f"no OBJ frames in {lab_dir}/drape-levels-N/frames/; make them with {COMMAND}")
+    target = lab_dir / "drape.png"
+    if figures.up_to_date(target, [path for run_dir in runs for path in mesh.frame_paths(run_dir)]):
+        return 0
     rows = []
     for run_dir in runs:
         paths = mesh.frame_paths(run_dir)
@@ -42,12 +40,9 @@ def main(out_dir):
     bar.set_label("edge stretch |l / l0 − 1| (log)")
     figure.suptitle(f"{rows[0][1].scene} at equal cost per step: the coarse levels pull the stretch out "
                     "and still let the cloth fold", fontsize=10)
-    target = lab_dir / "drape.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -3,34 +3,31 @@
 projections per step, flat Gauss-Seidel against 2-4 levels: max and RMS strain
 against time (from the `equal-cost-levels-N` runs of the demo: per_frame.csv
 and the summary beside it). Writes equal_cost.png."""
-import csv
-import json
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: ./course run lab10_solution --scene flat-curtain-64 --levels 3 "
+COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--scene flat-curtain-64 --levels 3 "
            "--iterations-per-level 12 --steps 180 --out out/lab10_hierarchical_pbd/equal-cost-levels-3 "
-           "--summary out/lab10_hierarchical_pbd/equal-cost-levels-3.json)")
+           "--summary out/lab10_hierarchical_pbd/equal-cost-levels-3.json)"))
 
 
 def main(out_dir):
     lab_dir = Path(out_dir) / LAB
-    runs = []
+    runs, sources = [], []
     for run_dir in sorted(lab_dir.glob("equal-cost-levels-*")):
         table, summary = run_dir / "per_frame.csv", lab_dir / (run_dir.name + ".json")
         if run_dir.is_dir() and table.exists() and summary.exists():
-            with open(table, newline="") as handle:
-                rows = [r for r in csv.DictReader(handle) if r["status"] == "ok"]
-            runs.append((json.loads(summary.read_text()), rows))
+            runs.append((figures.summary(summary), figures.rows(table, ok_only=True)))
+            sources += [table, summary]
     if not runs:
-        print(f"lab10_equal_cost: no {lab_dir}/equal-cost-levels-N/per_frame.csv; make them with {COMMAND}")
-        return 4
+        return figures.skip("lab10_equal_cost", f"no {lab_dir}/equal-cost-levels-N/per_frame.csv; make them with "
+                            f"{COMMAND}")
+    target = lab_dir / "equal_cost.png"
+    if figures.up_to_date(target, sources):
+        return 0
     runs.sort(key=lambda run: run[0]["levels"])
     figure, (left, right) = plt.subplots(1, 2, figsize=(11.5, 4.6))
     for summary, rows in runs:
@@ -50,12 +47,9 @@ def main(out_dir):
     figure.suptitle(f"{scene}: strain at equal cost per step (Δt = {runs[0][0]['dt']:.4g} s, hard constraints; "
                     "K sweeps per level, the cloth first)", fontsize=11)
     figure.tight_layout(rect=(0, 0, 1, 0.94))
-    target = lab_dir / "equal_cost.png"
-    figure.savefig(target, dpi=110)
-    plt.close(figure)
-    print(f"wrote {target}")
+    figures.save(figure, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else "out"))
+    figures.run(main)

@@ -7,7 +7,7 @@
 
 The bundle: this file, setup.sh, run_autograder, autograder.json (the lab and the
 time limits) and course/ (the student release of the lab's week plus the lab's
-hidden tests). It uses the tree's own tools/course.py and tools/grade.py.
+hidden tests). It uses the tree's own tools/cl/ package (build, labs, grade).
 
 Paths: AUTOGRADER_ROOT (default /autograder) holds submission/ and results/.
 AUTOGRADER_CASE_TIMEOUT and AUTOGRADER_RUN_LIMIT (seconds) override the time
@@ -28,8 +28,9 @@ TREE = HERE / "course"
 sys.path.insert(0, str(TREE / "tools"))
 os.environ["CL_BUILD_DIR"] = str(TREE / "build")  # never the instructor's build/
 
-import course  # noqa: E402  (the bundle's own tools/course.py)
-import grade  # noqa: E402
+from cl import build, grade  # noqa: E402  (the bundle's own tools/cl/)
+from cl.base import BIN, BUILD, ROOT  # noqa: E402
+from cl.labs import manifest  # noqa: E402
 
 AUTOGRADER_ROOT = Path(os.environ.get("AUTOGRADER_ROOT", "/autograder"))
 SUBMISSION = AUTOGRADER_ROOT / "submission"
@@ -37,7 +38,7 @@ RESULTS = AUTOGRADER_ROOT / "results" / "results.json"
 CONFIG = json.loads((HERE / "autograder.json").read_text())
 LAB = CONFIG["lab"]
 TAG = grade.lab_id(LAB)
-STATE = course.BUILD / "autograder"  # the case list and pristine stubs, written by setup
+STATE = BUILD / "autograder"  # the case list and pristine stubs, written by setup
 HIDDEN_TAG = "[hidden]"
 GRACE = 20  # seconds after the run limit before the alarm stops a build or a rerun
 SANITIZER_RERUNS = 2  # crashed cases rerun under the sanitizers, at most
@@ -57,17 +58,17 @@ def whole(value):
 
 def setup():
     start = time.monotonic()
-    course.configure(log=sys.stdout, force=True)
+    build.configure(log=sys.stdout, force=True)
     targets = [f"{LAB}_tests"]
     if os.environ.get("AUTOGRADER_PREBUILD_ASAN", "1") != "0":
         targets.append(f"{LAB}_tests_asan")
     try:
-        course.build_targets(targets, log=sys.stdout)
-    except course.BuildFailure as failure:
+        build.build_targets(targets, log=sys.stdout)
+    except build.BuildFailure as failure:
         print("\n".join(failure.lines), file=sys.stderr)
         print(f"setup: {LAB}'s tests do not build against the stubs", file=sys.stderr)
         return 1
-    binary = course.BIN / f"{LAB}_tests"
+    binary = BIN / f"{LAB}_tests"
     tag = grade.lab_tag(LAB)
     errors = []
     names = grade.list_names(binary, tag)
@@ -81,7 +82,7 @@ def setup():
     # Declaration order, the hidden cases last.
     cases = sorted(({"name": name, "points": points[name], "hidden": name in hidden} for name in names),
                    key=lambda case: case["hidden"])
-    students = course.manifest()[LAB]["student"]
+    students = manifest()[LAB]["student"]
     stubs = STATE / "stubs"
     stubs.mkdir(parents=True, exist_ok=True)
     for student in students:
@@ -163,7 +164,7 @@ def take_submission(students, report):
 
 def grade_cases(report, deadline, case_timeout, run_limit):
     """Run each case alone with a time limit; stop starting cases at the deadline."""
-    binary = course.BIN / f"{LAB}_tests"
+    binary = BIN / f"{LAB}_tests"
     reruns = 0
     with tempfile.TemporaryDirectory(prefix="cl-autograder-") as work:
         for case in report.cases:
@@ -172,7 +173,7 @@ def grade_cases(report, deadline, case_timeout, run_limit):
                 break
             limit = whole(min(case_timeout, round(left)))
             grade.CASE_TIMEOUT = limit
-            result = grade.run_case(binary, case["name"], case["points"], Path(work), course.ROOT)
+            result = grade.run_case(binary, case["name"], case["points"], Path(work), ROOT)
             if result.reason.startswith("timed out") and limit < case_timeout:
                 result.reason = (f"timed out: stopped after {limit} s, when the whole submission's time "
                                  f"limit ({whole(run_limit)} s) was reached")
@@ -181,7 +182,7 @@ def grade_cases(report, deadline, case_timeout, run_limit):
                                  "(an endless loop, or far too slow?)")
             if result.signal and reruns < SANITIZER_RERUNS and deadline - time.monotonic() > 30:
                 reruns += 1
-                result.reason = "\n".join([result.reason, *course.sanitizer_rerun(LAB, result, log=None)])
+                result.reason = "\n".join([result.reason, *build.sanitizer_rerun(LAB, result, log=None)])
             report.outcomes[case["name"]] = (result.score, grade.case_output(result))
 
 
@@ -203,8 +204,8 @@ def run():
     try:
         names = take_submission(state["student"], report)
         try:
-            output = course.build_targets([f"{LAB}_tests"], log=None)
-        except course.BuildFailure as failure:
+            output = build.build_targets([f"{LAB}_tests"], log=None)
+        except build.BuildFailure as failure:
             files = ", ".join(names)
             report.notes += [f"Your code ({files}) does not compile, so no test ran (score 0). "
                              "The compiler's first errors:",
@@ -212,7 +213,7 @@ def run():
             report.entries.append(("your code does not compile", "\n".join(failure.lines)))
             report.write(start, f"not run: {files} does not compile (the compiler's errors are at the top)")
             return 0
-        warnings = course.student_warnings(LAB, output)
+        warnings = build.student_warnings(LAB, output)
         if warnings:
             report.notes += [f"{len(warnings)} compiler warning(s) in your code (first 3):", *warnings[:3]]
         grade_cases(report, deadline, case_timeout, run_limit)

@@ -20,7 +20,7 @@ LIST_TIMEOUT = 60  # seconds for a listing
 UNSELECTABLE = re.compile(r'[,\[\]*\\"]|^~|^exclude:')
 PTS_TAG = re.compile(r"\[pts=([^\]]*)\]", re.IGNORECASE)
 # Cases tagged [hidden] (in tests/*/hidden_*.cpp) run only in the Gradescope
-# bundle (tools/autograder.py) and in the honesty checks; local grading skips them.
+# bundle (tools/cl/autograder.py) and in the honesty checks; local grading skips them.
 HIDDEN_TAG = "[hidden]"
 FAILURE_TAGS = ("Expression", "Exception", "FatalErrorCondition", "Failure")
 # OpenMP threads that wait sleep instead of spinning: on a shared or busy
@@ -41,6 +41,9 @@ class CaseResult:
     reason: str = ""  # one line
     details: list = field(default_factory=list)  # CAPTUREd values etc.
     signal: int = 0  # the signal that killed the case, 0 if none
+    # A failed expression in parts, for a terminal line that keeps what matters
+    # when it must be cut: the source text, Catch2's expansion, file:line.
+    parts: tuple = ()
 
     @property
     def score(self):
@@ -216,8 +219,8 @@ def run_case(binary, name, points, work, root):
         if done.returncode == 0:
             return CaseResult(name, points, True)
         return CaseResult(name, points, False, f"exit code {done.returncode} after the case passed")
-    reason, details = first_failure(test_case, root)
-    return CaseResult(name, points, False, reason, details)
+    reason, details, parts = first_failure(test_case, root)
+    return CaseResult(name, points, False, reason, details, parts=parts)
 
 
 def signal_name(number):
@@ -237,32 +240,55 @@ def read_test_case(report, name):
 
 
 def first_failure(test_case, root):
-    """(one-line reason, CAPTUREd values) for the first failure in a <TestCase>."""
+    """(one-line reason, context, parts) for the first failure in a <TestCase>;
+    the context lists INFO messages before CAPTUREd values (`name := value`),
+    so that a cut drops the captures first."""
     infos = []
     for element in test_case.iter():
         if element.tag == "Info":
             infos.append(text_of(element))
         elif element.tag in FAILURE_TAGS and element.get("success") != "true":
-            return describe(element, root), infos
+            reason, parts = describe(element, root)
+            captured = [info for info in infos if " := " in info]
+            return reason, [info for info in infos if " := " not in info] + captured, parts
         elif element.tag == "Expression":
             infos = []
-    return "failed without a failing assertion in the report", []
+    return "failed without a failing assertion in the report", [], ()
 
 
 def describe(element, root):
-    """One line for a failing <Expression>, <Exception>, <Failure> or fatal error."""
+    """(one line, parts) for a failing <Expression>, <Exception>, <Failure> or
+    fatal error; parts is (check, expansion, file:line) for an expression."""
     exception = element if element.tag == "Exception" else element.find("Exception")
     if exception is not None:
-        return text_of(exception)
+        return text_of(exception), ()
     where = location(element, root)
     if element.tag != "Expression":
-        return f"{text_of(element)} ({where})"
+        return f"{text_of(element)} ({where})", ()
     original = text_of(element.find("Original"))
     expanded = text_of(element.find("Expanded"))
     check = f"{element.get('type', 'CHECK')}( {original} )"
-    if expanded and expanded != original:
-        check += f" with {expanded}"
-    return f"{check} ({where})"
+    if not expanded or expanded == original:
+        expanded = ""
+    line = f"{check} with {expanded} ({where})" if expanded else f"{check} ({where})"
+    return line, (check, expanded, where)
+
+
+def terminal_reason(case, limit=None):
+    """A failed case's reason in about `limit` characters for the terminal: what
+    was found (Catch2's expansion: actual, expected, tolerance, where in the
+    matrix or mesh) and the file:line are kept; the check's source text is cut
+    first, then the end of the expansion."""
+    limit = limit or TERMINAL_CAP
+    if len(case.reason) <= limit or not case.parts or not case.parts[1]:
+        return clip(case.reason, limit)
+    check, expanded, where = case.parts
+    tail = f" ({where})"
+    room = limit - len(tail)
+    if len(expanded) + len(" with ") + 16 <= room:  # the whole expansion, the check's text cut
+        keep = room - len(expanded) - len(" with ") - len("... )")
+        return f"{check[:keep]}... ) with {expanded}{tail}"
+    return f"{expanded[:room - 3]}...{tail}"  # the expansion alone, cut at its end
 
 
 def location(element, root):

@@ -8,7 +8,7 @@ The bundle is a zip with, at its top (Gradescope unpacks it into /autograder/sou
                     /autograder/results/results.json (always valid JSON)
   autograder_run.py what both of them call
   autograder.json   the lab and the time limits
-  course/           the student release of the lab's week (course.write_release:
+  course/           the student release of the lab's week (write_release:
                     stubs for every lab, the reference code of earlier labs) plus
                     the lab's hidden tests, tests/labNN_x/hidden_*.cpp
 A TEST_CASE tagged [hidden] lives in a tests/*/hidden_*.cpp file: the student
@@ -21,16 +21,15 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 import tempfile
 import time
 import zipfile
 from pathlib import Path
 
-import course
-import grade
-
-ROOT = course.ROOT
+from . import grade
+from .base import BUILD, ROOT, CourseError, show
+from .labs import lab_dirs, resolve_lab
+from .release import write_release
 TEMPLATES = ROOT / "tools" / "gradescope"
 TEMPLATE_FILES = ("setup.sh", "run_autograder", "autograder_run.py")
 HIDDEN_TEST = re.compile(r"^tests/([^/]+)/hidden_[^/]*\.cpp$")
@@ -74,10 +73,10 @@ def write_bundle(lab, zip_path, case_timeout=CASE_TIMEOUT, run_limit=RUN_LIMIT):
     """Write the bundle for `lab` to zip_path; return (file count, the student's file names)."""
     students = sorted(p.name for p in (ROOT / "solutions" / lab).glob("*.cpp"))
     if not students:
-        raise course.CourseError(f"no reference in solutions/{lab}/: the bundle cannot be tested", code=2)
+        raise CourseError(f"no reference in solutions/{lab}/: the bundle cannot be tested", code=2)
     with tempfile.TemporaryDirectory(prefix="cl-bundle-") as work:
         stage = Path(work)
-        count = course.write_release(lab, stage / "course", keep=bundle_keep(lab))
+        count = write_release(lab, stage / "course", keep=bundle_keep(lab))
         for name in TEMPLATE_FILES:
             shutil.copy2(TEMPLATES / name, stage / name)
         config = {"lab": lab, "files": students, "case_timeout": case_timeout, "run_limit": run_limit}
@@ -103,13 +102,13 @@ def cmd_autograder(argv):
                         help=f"time limit of one submission's whole run, s (default {RUN_LIMIT}; "
                              "keep it below Gradescope's autograder timeout)")
     args = parser.parse_args(argv)
-    lab = course.resolve_lab(args.lab)
+    lab = resolve_lab(args.lab)
     tag = grade.lab_id(lab)
-    out = Path(args.out).resolve() if args.out else course.BUILD / "gradescope" / f"{tag}.zip"
+    out = Path(args.out).resolve() if args.out else BUILD / "gradescope" / f"{tag}.zip"
     count, students = write_bundle(lab, out, args.case_timeout, args.run_limit)
     visible, hidden, hidden_count = points_in_sources(lab)
     fmt = grade.fmt_points
-    print(f"{course.show(out)}: the Gradescope autograder for {tag} ({count} files)")
+    print(f"{show(out)}: the Gradescope autograder for {tag} ({count} files)")
     print(f"  accepts {', '.join(students)} (anywhere in the submission)")
     print(f"  {fmt(visible + hidden)} points: {fmt(visible)} in the tests students have, {fmt(hidden)} in "
           f"{hidden_count} hidden case{'s' if hidden_count != 1 else ''} (shown after the grades are published)")
@@ -147,7 +146,7 @@ def check_autograder(checks, lab_token="lab02"):
     folder laid out like Gradescope's, setup.sh, then run_autograder on (a) the
     reference, (b) the stubs, (c) code that does not compile, (d) an endless loop,
     (e) an empty submission."""
-    ids = {grade.lab_id(lab): lab for lab in course.lab_dirs()}
+    ids = {grade.lab_id(lab): lab for lab in lab_dirs()}
     lab = ids.get(lab_token)
     if lab is None:
         return
@@ -210,7 +209,7 @@ def check_autograder(checks, lab_token="lab02"):
             max_score = sum(t["max_score"] for t in data["tests"])
             return data, [f"score {grade.fmt_points(data['score'])}/{grade.fmt_points(max_score)}"], took
 
-        def show(data):
+        def output_lines(data):
             return [f"output: {line}" for line in data["output"].splitlines()[:6]]
 
         # (a) the reference, with an extra file: full marks, hidden cases after publishing.
@@ -220,7 +219,7 @@ def check_autograder(checks, lab_token="lab02"):
         ok = ok and bool(hidden_entries) and "notes.txt" in data["output"]
         checks.record(ok, f"autograder {lab_token} (a) the reference: {said[0]}, "
                       f"{len(hidden_entries)} hidden case(s) after_published, notes.txt listed ({took:.0f} s)",
-                      [] if ok else said + (show(data) if data else []))
+                      [] if ok else said + (output_lines(data) if data else []))
 
         # (b) the stubs: 0, every case ran and says not implemented.
         data, said, took = submit({"gauss_seidel.cpp": stub})
@@ -235,23 +234,22 @@ def check_autograder(checks, lab_token="lab02"):
         ok = (data is not None and data["score"] == 0 and f"labs/{lab}/gauss_seidel.cpp:" in data["output"]
               and "error" in data["output"])
         checks.record(ok, f"autograder {lab_token} (c) does not compile: {said[0]}, "
-                      f"the compiler's error in output ({took:.0f} s)", show(data) if data else said)
+                      f"the compiler's error in output ({took:.0f} s)", output_lines(data) if data else said)
 
-        # (d) an endless loop: the time limit fires, results.json is valid.
-        data, said, took = submit({"gauss_seidel.cpp": endless}, case_timeout=3, run_limit=10)
+        # (d) an endless loop: the time limit fires, results.json is valid. The
+        # submission's limit leaves room for its rebuild, which (c) just timed: on
+        # a busy machine a fixed 10 s was spent compiling before any case ran.
+        data, said, took = submit({"gauss_seidel.cpp": endless}, case_timeout=3, run_limit=round(10 + took))
         timed_out = [t["name"] for t in data["tests"] if "timed out" in t["output"]] if data else []
         ok = data is not None and data["score"] == 0 and bool(timed_out)
         checks.record(ok, f"autograder {lab_token} (d) an endless loop: {said[0]}, {len(timed_out)} case(s) "
                       f"timed out, results.json valid ({took:.0f} s)",
-                      [f"first: {timed_out[0]}" if timed_out else "no case timed out", *(show(data) if data else said)])
+                      [f"first: {timed_out[0]}" if timed_out else "no case timed out", *(output_lines(data) if data else said)])
 
         # (e) nothing submitted: 0 and a message naming the missing file.
         data, said, took = submit({})
         ok = data is not None and data["score"] == 0 and "gauss_seidel.cpp is missing" in data["output"]
         checks.record(ok, f"autograder {lab_token} (e) gauss_seidel.cpp missing: {said[0]}, named in output "
-                      f"({took:.0f} s)", [] if ok else said + (show(data) if data else []))
+                      f"({took:.0f} s)", [] if ok else said + (output_lines(data) if data else []))
     checks.record(True, f"autograder checks: {time.monotonic() - start:.0f} s")
 
-
-if __name__ == "__main__":
-    sys.exit(cmd_autograder(sys.argv[1:]))

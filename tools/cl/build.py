@@ -1,0 +1,146 @@
+"""Configure and build.
+
+One configure, then per-lab builds: `./course grade lab01` builds only the
+targets lab 01's grading needs, so a compile error in another lab blocks
+nothing else.
+"""
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+
+from . import grade
+from .base import BIN, BUILD, ROOT, CourseError
+from .labs import manifest, manifest_stale
+
+ERROR_LINES = 14  # of a failed build, shown
+WARNING_LINES = 3  # of the warnings in a student's files, shown
+
+
+class BuildFailure(Exception):
+    """Targets that did not build; `lines` is the compiler's first errors."""
+
+    def __init__(self, targets, lines):
+        super().__init__(f"{' '.join(targets)} did not build")
+        self.lines = lines
+
+
+def configure(log=sys.stdout, force=False):
+    """Configure BUILD when it is new or its lab manifest is out of date."""
+    if force or not (BUILD / "CMakeCache.txt").is_file() or manifest_stale():
+        print("configuring...", end=" ", file=log, flush=True)
+        start = time.monotonic()
+        try:
+            quiet(["cmake", "-S", str(ROOT), "-B", str(BUILD), "-DCMAKE_BUILD_TYPE=Release"], "configure")
+        finally:
+            print(f"{time.monotonic() - start:.1f} s", file=log, flush=True)
+
+
+def build(log=sys.stdout):
+    """Configure (first time) and build everything; show the output only on failure."""
+    configure(log)
+    print("building...", end=" ", file=log, flush=True)
+    start = time.monotonic()
+    try:
+        quiet(["cmake", "--build", str(BUILD), "-j", "2"], "build")
+    finally:
+        print(f"{time.monotonic() - start:.1f} s", file=log, flush=True)
+
+
+def quiet(command, what):
+    try:
+        done = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE,
+                              stderr=subprocess.STDOUT, text=True, check=False)
+    except FileNotFoundError:
+        raise CourseError(f"{command[0]} not found; ./course installs it") from None
+    if done.returncode != 0:
+        raise CourseError(f"{what} failed (cmake exit code {done.returncode})",
+                          details=done.stdout.splitlines())
+
+
+def build_targets(targets, build_dir=None, log=sys.stdout, label=None):
+    """Build only `targets`; return the tools' output. Raise BuildFailure."""
+    build_dir = build_dir or BUILD
+    if log is not None:
+        print(f"building {label or ' '.join(targets)}...", end=" ", file=log, flush=True)
+    start = time.monotonic()
+    try:
+        done = subprocess.run(["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets],
+                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              check=False)
+    except FileNotFoundError:
+        raise CourseError("cmake not found; ./course installs it") from None
+    finally:
+        if log is not None:
+            print(f"{time.monotonic() - start:.1f} s", file=log, flush=True)
+    if done.returncode != 0:
+        raise BuildFailure(targets, first_errors(done.stdout))
+    return done.stdout
+
+
+def first_errors(output):
+    """The compiler's first errors in a build log, paths relative to the root."""
+    lines = [line for line in output.splitlines()
+             if not re.match(r"^(\[\s*\d+%\]|gmake|make|Scanning|Consolidate|Built target)", line)
+             and "Error 1" not in line and "Error 2" not in line]
+    start = next((i for i, line in enumerate(lines)
+                  if re.search(r"\b(error|Error|undefined reference)\b", line)), None)
+    if start is None:
+        shown = lines[-ERROR_LINES:]
+    else:
+        # Keep the "In function ..." line that introduces the first error.
+        if start > 0 and re.search(r"In (member )?function|In file included", lines[start - 1]):
+            start -= 1
+        shown = lines[start:start + ERROR_LINES]
+    return [line.replace(str(ROOT) + "/", "") for line in shown]
+
+
+def student_warnings(lab, output):
+    """Warnings in the lab's student files: from this build's output for the
+    files it recompiled, remembered from the last compile for the others."""
+    cache = BUILD / "grade" / "warnings"
+    cache.mkdir(parents=True, exist_ok=True)
+    found = []
+    for student in manifest().get(lab, {}).get("student", []):
+        remembered = cache / (student.replace("/", "__") + ".txt")
+        if f"CMakeFiles/{lab}_student.dir/{student}.o" in output:
+            path = str(ROOT / student)
+            lines = [line.replace(str(ROOT) + "/", "") for line in output.splitlines()
+                     if line.startswith(path + ":") and ": warning:" in line]
+            remembered.write_text("".join(line + "\n" for line in lines))
+        if remembered.is_file():
+            found += remembered.read_text().splitlines()
+    return found
+
+
+def sanitizer_env(leaks):
+    """The environment of a sanitizer run. allow_user_segv_handler=0: Catch2 may not
+    take SIGSEGV/SIGABRT from the sanitizer, whose report then shows the faulting
+    line, not a re-raise."""
+    return dict(os.environ,
+                ASAN_OPTIONS=f"detect_leaks={int(leaks)}:allow_user_segv_handler=0:handle_abort=1",
+                UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1")
+
+
+def sanitizer_rerun(lab, case, log=sys.stdout):
+    """Rerun one crashed case in NAME_tests_asan (cmake/AddLab.cmake: the tests and
+    the student's code under -fsanitize=address,undefined -g -O1); lines saying
+    where it failed."""
+    target = f"{lab}_tests_asan"
+    try:
+        build_targets([target], log=log, label=f"{target} (-fsanitize=address,undefined)")
+    except BuildFailure as failure:
+        return ["the sanitizer build failed:", *failure.lines[:4]]
+    binary = BIN / target
+    # A crash is what is asked about here, so leaks are not reported.
+    env = sanitizer_env(leaks=False)
+    with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
+        try:
+            done = subprocess.run([str(binary), case.name], cwd=work, env=env, capture_output=True,
+                                  text=True, timeout=grade.CASE_TIMEOUT, check=False)
+        except subprocess.TimeoutExpired:
+            return ["the sanitizer run timed out"]
+    lines = grade.sanitizer_report(done.stdout + done.stderr, ROOT)
+    return lines or [f"the sanitizer build ran the case without a report (exit code {done.returncode})"]

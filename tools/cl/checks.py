@@ -1,0 +1,270 @@
+"""./course test: everything CI checks, in the order it runs them."""
+import argparse
+import shlex
+import shutil
+import subprocess
+import tempfile
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+from . import grade
+from .autograder import check_autograder
+from .base import BIN, BUILD, ROOT, CourseError, show
+from .build import BuildFailure, build_targets, configure
+from .demo import run_demos
+from .fuzz import check_fuzz
+from .grading import Grader, write_results
+from .labs import lab_dirs, lab_targets, manifest, reject_lines
+from .measure import check_measurements
+from .plots import run_plots
+from .release import is_release
+from .sanitize import check_sanitize
+from .student_loop import check_student_loop
+
+
+class Checks:
+    """Counts and prints pass/fail checks, and times the steps that make them."""
+
+    def __init__(self):
+        self.passed = 0
+        self.failed = 0
+        self.started = time.monotonic()
+        self.times = []  # (step, seconds, ran alongside other steps)
+
+    @contextmanager
+    def timed(self, step):
+        start = time.monotonic()
+        try:
+            yield
+        finally:
+            self.add_time(step, time.monotonic() - start)
+
+    def add_time(self, step, seconds, concurrent=False):
+        self.times.append((step, seconds, concurrent))
+
+    def record(self, ok, name, details=()):
+        if ok:
+            self.passed += 1
+        else:
+            self.failed += 1
+        print(f"{'ok  ' if ok else 'FAIL'}  {name}", flush=True)
+        for line in details:
+            print(f"        {line}")
+
+    def print_times(self):
+        """The timing table: each step's seconds and share of the whole run (a step
+        that ran alongside others has no share: its time is inside theirs)."""
+        total = max(time.monotonic() - self.started, 1e-9)
+        if not self.times:
+            return
+        rest = "(the rest: listing, waiting, Python)"
+        width = max(len(step) for step, _, _ in [*self.times, (rest, 0, False)])
+        print(f"\ntiming: {total:.0f} s in all")
+        for step, seconds, concurrent in self.times:
+            share = "alongside" if concurrent else f"{100 * seconds / total:5.1f} %"
+            print(f"  {step:<{width}}  {seconds:7.1f} s  {share}")
+        counted = sum(seconds for _, seconds, concurrent in self.times if not concurrent)
+        print(f"  {rest:<{width}}  {total - counted:7.1f} s  "
+              f"{100 * (total - counted) / total:5.1f} %")
+
+    def finish(self):
+        """Print the timing table and `N passed, M failed`; return the exit code."""
+        self.print_times()
+        print(f"{self.passed} passed, {self.failed} failed")
+        return 1 if self.failed else 0
+
+
+def build_labs(checks, labs):
+    """Build each lab's targets on its own; return the labs that built."""
+    built = []
+    for lab in labs:
+        entry = manifest().get(lab)
+        if entry is None:
+            checks.record(False, f"{lab}: not added in CMakeLists.txt (add_lab)")
+            continue
+        targets = [lab, *lab_targets(lab)]
+        if entry["reference"]:
+            targets += [f"{lab}_solution", *lab_targets(lab, solutions=True)]
+        try:
+            with checks.timed(f"build {lab}"):
+                build_targets(list(dict.fromkeys(targets)), log=None)
+        except BuildFailure as failure:
+            checks.record(False, f"{lab} does not build", failure.lines)
+            continue
+        built.append(lab)
+    return built
+
+
+def check_ctest(checks):
+    try:
+        with checks.timed("build common_tests"):
+            build_targets(["common_tests"], log=None)
+    except BuildFailure as failure:
+        checks.record(False, "common_tests does not build", failure.lines)
+        return
+    with checks.timed("unit tests (ctest -L unit)"):
+        done = subprocess.run(["ctest", "--test-dir", str(BUILD), "-L", "unit", "--output-on-failure"],
+                              cwd=ROOT, capture_output=True, text=True, check=False)
+    ok = done.returncode == 0
+    lines = [line for line in done.stdout.splitlines() if "tests passed" in line]
+    details = [] if ok else (done.stdout + done.stderr).splitlines()
+    checks.record(ok, f"ctest -L unit: {lines[-1] if lines else 'no tests found'}", details)
+
+
+def check_solutions(checks, labs):
+    grader = Grader(solutions=True, log=None, info=False, hidden=True)
+    results = [grader.grade(lab) for lab in labs]
+    write_results(BUILD / "grade" / "solutions" / "results.json", results)
+    for r in results:
+        fmt = grade.fmt_points
+        details = [f'"{c.name}": {c.reason}' for c in r.failed] + r.errors
+        ok = not details and bool(r.cases) and r.score == r.max_score
+        checks.record(ok, f"{r.lab} solutions: {fmt(r.score)}/{fmt(r.max_score)}", details)
+
+
+def check_stubs(checks, labs):
+    grader = Grader(log=None, sanitize=False, info=False, hidden=True)
+    results = [grader.grade(lab) for lab in labs]
+    write_results(BUILD / "grade" / "stubs" / "results.json", results)
+    for r in results:
+        details = [f'passes on the stubs: "{c.name}"' for c in r.passed] + r.errors
+        if not r.cases:
+            summary = "no graded cases"
+        elif r.passed:
+            summary = f"{len(r.passed)} of {len(r.cases)} graded cases pass"
+        else:
+            summary = f"all {len(r.cases)} graded cases fail"
+        checks.record(not details and bool(r.cases), f"{r.lab} stubs: {summary}", details)
+
+
+def report_student_score(labs):
+    grader = Grader(log=None)
+    results = [grader.grade(lab) for lab in labs]
+    write_results(BUILD / "grade" / "results.json", results)
+    fmt = grade.fmt_points
+    for r in results:
+        if r.build_errors:
+            print(f"      {r.lab} (your code): does not compile (./course grade {grade.lab_id(r.lab)})")
+            continue
+        print(f"      {r.lab} (your code): {fmt(r.score)}/{fmt(r.max_score)}")
+        for error in r.errors:
+            print(f"        {error}")
+        for note in grader.dependency_notes(r.lab):
+            print(f"        {note}")
+
+
+def check_demo(checks, out, labs, student_fallback=True):
+    shutil.rmtree(out, ignore_errors=True)
+    try:
+        run_demos(out, echo=False, labs=labs, student_fallback=student_fallback)
+    except CourseError as error:
+        checks.record(False, f"demo: {error}", error.details)
+        return
+    checks.record(True, f"demo -> {show(out)}/")
+
+
+def refusal_problem(program, args, expected):
+    """Run PROGRAM on one bad input in a scratch folder; what is wrong with how
+    it refused (None: exit code 2, one stderr line containing EXPECTED, nothing
+    written). A --scene argument that starts with `{` is JSON, written to
+    scratch/bad.json first; `{tmp}` is the scratch folder."""
+    with tempfile.TemporaryDirectory(prefix="cl-reject-") as scratch:
+        scratch = Path(scratch)
+        argv = [arg.replace("{tmp}", str(scratch)) for arg in args]
+        for i in range(1, len(argv)):
+            if argv[i - 1] == "--scene" and argv[i].startswith("{"):
+                (scratch / "bad.json").write_text(argv[i])
+                argv[i] = str(scratch / "bad.json")
+        before = sorted(scratch.rglob("*"))
+        try:
+            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True, text=True,
+                                  timeout=60, check=False)
+        except subprocess.TimeoutExpired:
+            return "ran past 60 s instead of refusing"
+        lines = done.stderr.splitlines()
+        if done.returncode != 2:
+            return f"exit code {done.returncode}, not 2; stderr: {' | '.join(lines[-3:]) or '(empty)'}"
+        if len(lines) != 1:
+            return f"{len(lines)} stderr lines, not 1: {' | '.join(lines[:3])}"
+        if expected not in lines[0]:
+            return f"the line does not say '{expected}': {lines[0]}"
+        written = [str(p.relative_to(scratch)) for p in sorted(scratch.rglob("*")) if p not in before]
+        if written:
+            return f"left output behind: {', '.join(written[:3])}"
+    return None
+
+
+def check_rejects(checks, labs):
+    """Every line of labs/*/rejects.txt: the lab's executable refuses it (docs/DESIGN.md §3)."""
+    entries = manifest()
+    for lab in labs:
+        try:
+            cases = reject_lines(lab)
+        except CourseError as error:
+            checks.record(False, str(error))
+            continue
+        if not cases:
+            continue
+        name = lab + ("_solution" if entries[lab]["reference"] else "")
+        program = BIN / name
+        problems = []
+        for args, expected in cases:
+            problem = refusal_problem(program, args, expected)
+            if problem:
+                problems.append(f"{shlex.join(args)}: {problem}")
+        checks.record(not problems, f"{lab} refuses {len(cases) - len(problems)}/{len(cases)} bad inputs "
+                      f"(labs/{lab}/rejects.txt: exit 2, one line, nothing written)", problems)
+
+
+def cmd_test(argv):
+    argparse.ArgumentParser(prog="course test").parse_args(argv)
+    checks = Checks()
+    try:
+        with checks.timed("configure"):
+            configure()
+    except CourseError as error:
+        checks.record(False, str(error), error.details)
+        return checks.finish()
+    labs = build_labs(checks, lab_dirs())
+    check_ctest(checks)
+    out = BUILD / "test-demo"
+    if is_release():
+        print("a student release: grading your code (a score, not a check)")
+        with checks.timed("grading your code"):
+            report_student_score(labs)
+        with_reference = [lab for lab in labs if manifest()[lab]["reference"]]
+        with checks.timed("demo"):
+            check_demo(checks, out, with_reference, student_fallback=False)
+        with checks.timed("rejects"):
+            check_rejects(checks, with_reference)
+    else:
+        without = [lab for lab in labs if not manifest()[lab]["reference"]]
+        for lab in without:
+            checks.record(False, f"{lab}: no reference in solutions/{lab}/ (the honesty check needs one)")
+        labs = [lab for lab in labs if lab not in without]
+        # The fuzzer runs on one core for a minute: alongside the honesty checks,
+        # which run one single-threaded test process at a time.
+        fuzzing = check_fuzz(checks)
+        with checks.timed("honesty: the solutions graded"):
+            check_solutions(checks, labs)
+        with checks.timed("honesty: the stubs graded"):
+            check_stubs(checks, labs)
+        if fuzzing:
+            fuzzing()
+        with checks.timed("demo"):
+            check_demo(checks, out, labs)
+        with checks.timed("rejects"):
+            check_rejects(checks, labs)
+        check_measurements(checks, out)
+        check_sanitize(checks)
+    with checks.timed("plots (every figure, redrawn)"):
+        for script, outcome in run_plots(out, echo=False).items():
+            checks.record(outcome.status in ("ok", "skipped") if is_release() else outcome.status == "ok",
+                          f"plots/{script} on {show(out)}: {outcome.status}", outcome.lines)
+    if not is_release():
+        with checks.timed("student loop (a temporary release)"):
+            check_student_loop(checks)
+        with checks.timed("autograder (a bundle, five submissions)"):
+            check_autograder(checks)
+    return checks.finish()

@@ -1,0 +1,97 @@
+"""The labs: their folders, the build's manifest of them (build/labs.json),
+their demo.txt and rejects.txt.
+
+CMake writes build/labs.json (cmake/AddLab.cmake): per lab its student files,
+whether it has a reference, its earlier labs and which of them the graded tests
+link as reference or as the student's code.
+"""
+import json
+import shlex
+from pathlib import Path
+
+from . import grade
+from .base import BIN, BUILD, ROOT, CourseError, show
+
+MANIFEST = BUILD / "labs.json"
+
+
+def manifest():
+    """build/labs.json's "labs": {lab: {student, reference, info, deps, links}}."""
+    try:
+        return json.loads(MANIFEST.read_text())["labs"]
+    except (OSError, ValueError, KeyError):
+        return {}
+
+
+def manifest_stale():
+    """True when a lab or a reference appeared or went since the last configure."""
+    labs = manifest()
+    if not labs:
+        return True
+    declared = (ROOT / "CMakeLists.txt").read_text()
+    if any(lab not in labs and f"add_lab({lab} " in declared for lab in lab_dirs()):
+        return True
+    for lab, entry in labs.items():
+        present = all((ROOT / "solutions" / lab / Path(f).name).is_file() for f in entry["student"])
+        if present != entry["reference"]:
+            return True
+    return False
+
+
+def lab_dirs():
+    """Lab directory names, labs/labNN_*, sorted."""
+    return sorted(p.name for p in (ROOT / "labs").glob("lab[0-9][0-9]_*") if p.is_dir())
+
+
+def resolve_lab(token):
+    """`lab01` or `lab01_single_spring` -> `lab01_single_spring`."""
+    for lab in lab_dirs():
+        if token in (lab, grade.lab_id(lab)):
+            return lab
+    known = ", ".join(grade.lab_id(lab) for lab in lab_dirs()) or "none yet"
+    raise CourseError(f"unknown lab '{token}' (labs: {known})", code=2)
+
+
+def executable(name):
+    path = BIN / name
+    if not path.is_file():
+        raise CourseError(f"{show(path)} not found (is it added in CMakeLists.txt?)")
+    return path
+
+
+def lab_targets(lab, solutions=False):
+    """The targets grading `lab` needs: its graded tests (and its info program)."""
+    entry = manifest().get(lab, {})
+    suffix = "_solution" if solutions else ""
+    targets = [f"{lab}_tests{suffix}"]
+    if entry.get("info"):
+        targets.append(f"{lab}_info{suffix}")
+        if not solutions and entry.get("reference"):
+            targets.append(f"{lab}_info_solution")
+    return targets
+
+
+def demo_lines(lab):
+    """The argument lists in labs/LAB/demo.txt."""
+    demo = ROOT / "labs" / lab / "demo.txt"
+    if not demo.is_file():
+        return []
+    lines = (line.strip() for line in demo.read_text().splitlines())
+    return [shlex.split(line) for line in lines if line and not line.startswith("#")]
+
+
+def reject_lines(lab):
+    """labs/LAB/rejects.txt: (arguments, expected text) per line `ARGS -> TEXT`."""
+    path = ROOT / "labs" / lab / "rejects.txt"
+    if not path.is_file():
+        return []
+    found = []
+    for number, line in enumerate(path.read_text().splitlines(), 1):
+        line = line.strip()
+        if not line or line.startswith("#"):
+            continue
+        args, arrow, expected = line.rpartition(" -> ")
+        if not arrow or not args.strip() or not expected.strip():
+            raise CourseError(f"{show(path)}:{number}: expected `ARGS -> TEXT`")
+        found.append((shlex.split(args), expected.strip()))
+    return found

@@ -1,0 +1,87 @@
+"""./course bench and ./course extremes: the measurements (bench/), and their CI check."""
+import argparse
+import shlex
+import subprocess
+import sys
+
+from .base import BUILD, ROOT, CourseError, under_root
+from .build import BuildFailure, build_targets, configure
+from .labs import executable
+from .plots import plots_failed, run_plots
+
+MEASUREMENT_PLOTS = {"trade": ("bench_pareto.py", "bench_scaling.py"), "extremes": ("bench_extremes.py",)}
+
+
+def run_measurement(program, args, out, echo=True):
+    """Build and run bench/PROGRAM (trade or extremes) into OUT/bench.
+    Return (exit code, output lines); with echo the output goes to the terminal as it comes."""
+    build_targets([program], log=sys.stdout if echo else None)
+    path = executable(program)
+    command = [str(path), "--out", str(out / "bench"), *args]
+    if echo:
+        print("  " + shlex.join([path.name, *command[1:]]), flush=True)
+    done = subprocess.run(command, cwd=ROOT, capture_output=not echo, text=True, check=False)
+    return done.returncode, [] if echo else (done.stdout + done.stderr).splitlines()
+
+
+def measurement_command(program, argv):
+    """./course bench | extremes [--quick] [--out DIR]: the program, then the figures."""
+    parser = argparse.ArgumentParser(prog=f"course {'bench' if program == 'trade' else program}")
+    parser.add_argument("--quick", action="store_true", help="the CI size (minutes, not tens of them)")
+    parser.add_argument("--out", default="out", help="output directory (default out/; CSV in OUT/bench)")
+    if program == "trade":
+        parser.add_argument("--micro", nargs=argparse.REMAINDER,
+                            help="also run the Google Benchmark programs (bench_*), ARGS pass through")
+    args = parser.parse_args(argv)
+    configure()
+    out = under_root(args.out)
+    code, _ = run_measurement(program, ["--quick"] if args.quick else [], out)
+    if plots_failed(run_plots(out, names=MEASUREMENT_PLOTS[program])):
+        code = max(code, 1)
+    if program == "trade" and args.micro is not None:
+        code = max(code, run_micro(args.micro))
+    return code
+
+
+def micro_targets():
+    """The Google Benchmark programs: bench/bench_NAME.cpp is the target bench_NAME,
+    where this build defines it (bench/CMakeLists.txt adds those whose references exist)."""
+    names = sorted(path.stem for path in (ROOT / "bench").glob("bench_*.cpp"))
+    return [name for name in names if (BUILD / "bench" / "CMakeFiles" / f"{name}.dir").is_dir()]
+
+
+def run_micro(argv):
+    targets = micro_targets()
+    if not targets:
+        raise CourseError("no Google Benchmark program in this build (bench/bench_*.cpp need "
+                          "libbenchmark-dev and the labs' references)")
+    build_targets(targets)
+    failed = []
+    for name in targets:
+        print(f"== {name}", flush=True)
+        if subprocess.run([str(executable(name)), *argv], cwd=ROOT, check=False).returncode != 0:
+            failed.append(name)
+    if failed:
+        raise CourseError(f"failed: {' '.join(failed)}")
+    return 0
+
+
+def cmd_bench(argv):
+    return measurement_command("trade", argv)
+
+
+def cmd_extremes(argv):
+    return measurement_command("extremes", argv)
+
+
+def check_measurements(checks, out):
+    """CI: the quick trade and extremes runs (extremes fails on any silent NaN)."""
+    for program in ("trade", "extremes"):
+        try:
+            with checks.timed(f"measurements: {program} --quick (build and run)"):
+                code, lines = run_measurement(program, ["--quick"], out, echo=False)
+        except (CourseError, BuildFailure) as error:
+            checks.record(False, f"{program} --quick: {error}")
+            continue
+        checks.record(code == 0, f"{program} --quick: {lines[-1] if lines else 'no output'}",
+                      [] if code == 0 else lines[-20:])
