@@ -29,8 +29,10 @@ TEST_CASE("the general form reproduces the distance projection", "[lab01][pts=1]
     const cl::lab01::DistanceCorrection special =
         cl::lab01::project_distance(x_i, x_j, inv_mass_i, inv_mass_j, rest_length);
     REQUIRE(general.cols() == 2);
-    REQUIRE(cl::test::near((general.col(0) - special.dx_i).norm(), 0.0, 1e-14, "‖column 0 − dx_i of project_distance‖"));
-    REQUIRE(cl::test::near((general.col(1) - special.dx_j).norm(), 0.0, 1e-14, "‖column 1 − dx_j of project_distance‖"));
+    REQUIRE(cl::test::near((general.col(0) - special.dx_i).norm(), 0.0, 1e-14,
+                           "‖column 0 − dx_i of project_distance‖"));
+    REQUIRE(cl::test::near((general.col(1) - special.dx_j).norm(), 0.0, 1e-14,
+                           "‖column 1 − dx_j of project_distance‖"));
   }
 }
 

@@ -73,8 +73,10 @@ TEST_CASE("the correction splits by inverse mass along the constraint", "[lab01]
                                 "share of end i, |dx_i| / (|dx_i| + |dx_j|)"));
     // Both corrections lie along d = x_i − x_j.
     const Vector3d d = item.x_i - item.x_j;
-    REQUIRE(cl::test::near(d.cross(correction.dx_i).norm(), 0.0, 1e-12 * d.norm() * correction.dx_i.norm(), "‖d × dx_i‖"));
-    REQUIRE(cl::test::near(d.cross(correction.dx_j).norm(), 0.0, 1e-12 * d.norm() * correction.dx_j.norm(), "‖d × dx_j‖"));
+    REQUIRE(cl::test::near(d.cross(correction.dx_i).norm(), 0.0, 1e-12 * d.norm() * correction.dx_i.norm(),
+                           "‖d × dx_i‖"));
+    REQUIRE(cl::test::near(d.cross(correction.dx_j).norm(), 0.0, 1e-12 * d.norm() * correction.dx_j.norm(),
+                           "‖d × dx_j‖"));
   }
 }
 

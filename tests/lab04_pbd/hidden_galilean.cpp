@@ -8,7 +8,7 @@
 
 #include "common/scene.h"
 #include "pbd.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 
 using cl::lab04::PbdSettings;
 using cl::lab04::Projection;
@@ -46,7 +46,7 @@ TEST_CASE("adding one velocity u to every particle of a free cloth only carries 
     }
     const Matrix3Xd carried = rest_frame.x.colwise() + (steps * settings.dt) * u;
     const Matrix3Xd carried_v = rest_frame.v.colwise() + u;
-    REQUIRE(cl::test::difference(moving.x, carried) <= 1e-10);
-    REQUIRE(cl::test::difference(moving.v, carried_v) <= 1e-8);
+    REQUIRE(cl::test::near(moving.x, carried, 1e-10, "particle"));
+    REQUIRE(cl::test::near(moving.v, carried_v, 1e-8, "particle"));
   }
 }
