@@ -10,9 +10,14 @@
 //                                  solve of an n × 3 right-hand side (one pass per column)
 //   BM_PdIteration/128         local step + right-hand side + solve3, the whole iteration
 //   BM_Factorization/128       SimplicialLDLT of A (AMD ordering + numeric), once per scene
-//   BM_NewtonHessianFactor/N   a fresh SimplicialLDLT of Newton's 3n × 3n Hessian, once per iteration
-//   BM_Cholmod*                the same with CHOLMOD's supernodal LLᵀ (only when built with
-//                              CHOLMOD: Debian's libsuitesparse-dev)
+//   BM_FactorBackends/M/N/B    the numeric factorization alone (refactor: the analysis kept, as
+//                              Newton does every iteration) of matrix M (0: PD's A, n × n;
+//                              1: Newton's Hessian, 3n × 3n) at size N² by backend B (0: Eigen's
+//                              simplicial LDLᵀ, 1: CHOLMOD's supernodal LLᵀ, when built with
+//                              it), with the flop count that SpdBackend::kAutomatic compares
+//                              with kSupernodalFlops (common/sparse.h)
+//   BM_SolveBackends/M/N/B     the three-coordinate solve3 with that factor
+//   BM_NewtonHessianAssembly/N the Hessian's values into its fixed pattern, once per iteration
 // Wall time throughout (UseRealTime).
 #include <algorithm>
 #include <map>
@@ -20,10 +25,6 @@
 #include <string>
 
 #include <benchmark/benchmark.h>
-
-#ifdef CL_HAVE_CHOLMOD
-#include <Eigen/CholmodSupport>
-#endif
 
 #include "common/scene.h"
 #include "common/sparse.h"
@@ -70,7 +71,7 @@ cl::RowsX3 right_hand_side_of(const Curtain& c) {
 
 void BM_Solve3OnePass(benchmark::State& state) {
   const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  cl::SpdFactorization factor;
+  cl::SpdFactorization factor(cl::SpdBackend::kSimplicial);
   factor.factor(c.a);
   const cl::RowsX3 b = right_hand_side_of(c);
   for (auto _ : state) {
@@ -84,7 +85,7 @@ void BM_Solve3OnePass(benchmark::State& state) {
 
 void BM_EigenSolve3Columns(benchmark::State& state) {
   const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  cl::SpdFactorization factor;
+  cl::SpdFactorization factor(cl::SpdBackend::kSimplicial);
   factor.factor(c.a);
   const Eigen::MatrixX3d b = right_hand_side_of(c);  // column-major: Eigen's natural layout
   for (auto _ : state) {
@@ -100,7 +101,7 @@ void BM_EigenSolve3Columns(benchmark::State& state) {
 // Counters: the median of each and their ratio.
 void BM_Solve3AgainstEigen(benchmark::State& state) {
   const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  cl::SpdFactorization factor;
+  cl::SpdFactorization factor(cl::SpdBackend::kSimplicial);
   factor.factor(c.a);
   const cl::RowsX3 b = right_hand_side_of(c);
   const Eigen::MatrixX3d b_columns = b;
@@ -154,83 +155,77 @@ void BM_LocalStep(benchmark::State& state) {
 void BM_Factorization(benchmark::State& state) {
   const Curtain& c = curtain(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    cl::SpdFactorization factor;
+    cl::SpdFactorization factor(cl::SpdBackend::kSimplicial);
     benchmark::DoNotOptimize(factor.factor(c.a));
   }
   count_unknowns(state, c);
 }
 
-void BM_NewtonHessianFactor(benchmark::State& state) {
-  const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  const cl::SparseMatrix hessian = cl::lab06::newton_hessian(c.problem, c.y);
-  for (auto _ : state) {
-    cl::SpdFactorization factor;
-    benchmark::DoNotOptimize(factor.factor(hessian));
+// The matrix of BM_FactorBackends and BM_SolveBackends: PD's A or Newton's Hessian.
+const cl::SparseMatrix& matrix_of(const Curtain& c, long which) {
+  static std::map<int, cl::SparseMatrix> hessians;
+  if (which == 0) return c.a;
+  const int n = static_cast<int>(c.problem.map.unknowns());
+  auto found = hessians.find(n);
+  if (found == hessians.end()) found = hessians.emplace(n, cl::lab06::newton_hessian(c.problem, c.y)).first;
+  return found->second;
+}
+
+cl::SpdBackend backend_of(long index) {
+  return index == 0 ? cl::SpdBackend::kSimplicial : cl::SpdBackend::kSupernodal;
+}
+
+// Labels the run with its matrix and backend, or skips it when the backend is
+// not there (CHOLMOD without a build that found it).
+bool describe(benchmark::State& state, const cl::SpdFactorization& factor) {
+  const std::string matrix = state.range(0) == 0 ? "A" : "hessian";
+  if (factor.backend() != backend_of(state.range(2))) {
+    state.SkipWithError("this build has no CHOLMOD");
+    return false;
   }
-  count_unknowns(state, c);
+  state.SetLabel(matrix + " " + cl::backend_name(factor.backend()));
+  state.counters["rows"] = static_cast<double>(factor.size());
+  state.counters["flops"] = factor.flops();
+  return true;
+}
+
+void BM_FactorBackends(benchmark::State& state) {
+  const Curtain& c = curtain(static_cast<int>(state.range(1)));
+  const cl::SparseMatrix& matrix = matrix_of(c, state.range(0));
+  cl::SpdFactorization factor(backend_of(state.range(2)));
+  if (!factor.factor(matrix)) {
+    state.SkipWithError("not positive definite");
+    return;
+  }
+  if (!describe(state, factor)) return;
+  for (auto _ : state) benchmark::DoNotOptimize(factor.refactor(matrix));
+}
+
+void BM_SolveBackends(benchmark::State& state) {
+  const Curtain& c = curtain(static_cast<int>(state.range(1)));
+  const cl::SparseMatrix& matrix = matrix_of(c, state.range(0));
+  cl::SpdFactorization factor(backend_of(state.range(2)));
+  if (!factor.factor(matrix)) {
+    state.SkipWithError("not positive definite");
+    return;
+  }
+  if (!describe(state, factor)) return;
+  const cl::RowsX3 b = cl::RowsX3::Ones(matrix.rows(), 3);
+  for (auto _ : state) {
+    cl::RowsX3 x = factor.solve3(b);
+    benchmark::DoNotOptimize(x.data());
+  }
 }
 
 void BM_NewtonHessianAssembly(benchmark::State& state) {
   const Curtain& c = curtain(static_cast<int>(state.range(0)));
+  cl::lab06::HessianAssembly assembly(c.problem);
   for (auto _ : state) {
-    cl::SparseMatrix hessian = cl::lab06::newton_hessian(c.problem, c.y);
+    const cl::SparseMatrix& hessian = assembly.update(c.problem, c.y);
     benchmark::DoNotOptimize(hessian.valuePtr());
   }
   count_unknowns(state, c);
 }
-
-#ifdef CL_HAVE_CHOLMOD
-template <typename Matrix>
-void cholmod_factor_and_solve(benchmark::State& state, const Matrix& matrix, const Eigen::MatrixXd& b) {
-  for (auto _ : state) {
-    Eigen::CholmodSupernodalLLT<cl::SparseMatrix> llt;
-    llt.compute(matrix);
-    Eigen::MatrixXd x = llt.solve(b);
-    benchmark::DoNotOptimize(x.data());
-  }
-}
-
-void BM_CholmodFactorSolve(benchmark::State& state) {
-  const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  cholmod_factor_and_solve(state, c.a, Eigen::MatrixXd(right_hand_side_of(c)));
-  count_unknowns(state, c);
-}
-
-void BM_SimplicialFactorSolve(benchmark::State& state) {
-  const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  const cl::RowsX3 b = right_hand_side_of(c);
-  for (auto _ : state) {
-    cl::SpdFactorization factor;
-    factor.factor(c.a);
-    cl::RowsX3 x = factor.solve3(b);
-    benchmark::DoNotOptimize(x.data());
-  }
-  count_unknowns(state, c);
-}
-
-void BM_CholmodSolve3(benchmark::State& state) {
-  const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  Eigen::CholmodSupernodalLLT<cl::SparseMatrix> llt;
-  llt.compute(c.a);
-  const Eigen::MatrixXd b = right_hand_side_of(c);
-  for (auto _ : state) {
-    Eigen::MatrixXd x = llt.solve(b);
-    benchmark::DoNotOptimize(x.data());
-  }
-  count_unknowns(state, c);
-}
-
-void BM_CholmodNewtonHessianFactor(benchmark::State& state) {
-  const Curtain& c = curtain(static_cast<int>(state.range(0)));
-  const cl::SparseMatrix hessian = cl::lab06::newton_hessian(c.problem, c.y);
-  for (auto _ : state) {
-    Eigen::CholmodSupernodalLLT<cl::SparseMatrix> llt;
-    llt.compute(hessian);
-    benchmark::DoNotOptimize(llt.info());
-  }
-  count_unknowns(state, c);
-}
-#endif
 
 }  // namespace
 
@@ -241,13 +236,15 @@ BENCHMARK(BM_EigenSolve3Columns)->Arg(128)->Arg(32)->UseRealTime()->Unit(benchma
 BENCHMARK(BM_PdIteration)->Arg(128)->Arg(64)->Arg(32)->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_LocalStep)->Arg(128)->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_Factorization)->Arg(128)->Arg(64)->Arg(32)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_NewtonHessianAssembly)->Arg(64)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_NewtonHessianFactor)->Arg(64)->Arg(32)->UseRealTime()->Unit(benchmark::kMillisecond);
-#ifdef CL_HAVE_CHOLMOD
-BENCHMARK(BM_SimplicialFactorSolve)->Arg(128)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_CholmodFactorSolve)->Arg(128)->UseRealTime()->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_CholmodSolve3)->Arg(128)->UseRealTime()->Unit(benchmark::kMicrosecond);
-BENCHMARK(BM_CholmodNewtonHessianFactor)->Arg(64)->Arg(32)->UseRealTime()->Unit(benchmark::kMillisecond);
-#endif
+BENCHMARK(BM_NewtonHessianAssembly)->Arg(128)->Arg(64)->UseRealTime()->Unit(benchmark::kMillisecond);
+// Matrix × size × backend: each size's two backends one after the other.
+BENCHMARK(BM_FactorBackends)
+    ->ArgsProduct({{0, 1}, {32, 64, 128}, {0, 1}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SolveBackends)
+    ->ArgsProduct({{0, 1}, {64, 128}, {0, 1}})
+    ->UseRealTime()
+    ->Unit(benchmark::kMicrosecond);
 
 BENCHMARK_MAIN();

@@ -127,6 +127,18 @@ class XpbdStepper : public Stepper {
   Eigen::VectorXd lambda_;
 };
 
+// The SpdFactorization backends that factored something since `before`,
+// joined by "+" ("none" if none did).
+std::string backends_since(const SpdBackendCounts& before) {
+  const SpdBackendCounts now = spd_backend_counts();
+  std::string names;
+  if (now.simplicial > before.simplicial) names = backend_name(SpdBackend::kSimplicial);
+  if (now.supernodal > before.supernodal) {
+    names += std::string(names.empty() ? "" : "+") + backend_name(SpdBackend::kSupernodal);
+  }
+  return names.empty() ? "none" : names;
+}
+
 class ImplicitEulerStepper : public Stepper {
  public:
   ImplicitEulerStepper(const Scene& scene, int iterations, lab06::Method method)
@@ -136,7 +148,7 @@ class ImplicitEulerStepper : public Stepper {
   }
   StepOutcome step(Particles& particles) override {
     const lab06::StepReport report = solver_.step(particles, settings_);
-    return {report.problem, report.iterations_done};
+    return {report.problem, report.iterations_done, solver_.linear_solver()};
   }
 
  private:
@@ -148,20 +160,28 @@ class ConstrainedStepper : public Stepper {
  public:
   ConstrainedStepper(const Scene& scene, lab07::Method method)
       : springs_(scene.springs), map_(make_movable_map(scene.particles.inv_mass)) {
-    lab07::compliance_of(springs_);  // rejects a bad stiffness now
+    const Eigen::VectorXd compliance = lab07::compliance_of(springs_);  // rejects a bad stiffness now
     settings_.dt = scene.dt;
     settings_.gravity = scene.gravity;
     settings_.method = method;
+    // Lab 07's rule (constrained.h, solve_kkt): the quasi-definite LDLᵀ when
+    // every c_e > 0, else the LU.
+    all_compliant_ = compliance.size() == static_cast<Eigen::Index>(springs_.size()) && (compliance.array() > 0.0).all();
   }
   StepOutcome step(Particles& particles) override {
+    const SpdBackendCounts before = spd_backend_counts();
     const lab07::StepResult result = lab07::constrained_step(particles, springs_, map_, settings_);
-    return {result.ok ? std::string() : result.problem, 1};
+    const std::string solver = settings_.method == lab07::Method::kKkt
+                                   ? std::string(all_compliant_ ? "quasi-definite-ldlt" : "sparse-lu")
+                                   : backends_since(before);
+    return {result.ok ? std::string() : result.problem, 1, solver};
   }
 
  private:
   std::vector<Spring> springs_;
   MovableMap map_;
   lab07::StepSettings settings_;
+  bool all_compliant_ = false;
 };
 
 class StableStepper : public Stepper {
@@ -174,10 +194,11 @@ class StableStepper : public Stepper {
     settings_.step.method = lab07::Method::kSchur;
   }
   StepOutcome step(Particles& particles) override {
+    const SpdBackendCounts before = spd_backend_counts();
     const lab09::StableStepResult result = lab09::stable_step(particles, springs_, map_, settings_, lambda_);
-    if (!result.ok) return {result.problem, 1};
+    if (!result.ok) return {result.problem, 1, backends_since(before)};
     lambda_ = result.lambda;
-    return {{}, 1};
+    return {{}, 1, backends_since(before)};
   }
 
  private:

@@ -42,6 +42,10 @@ const MethodInfo& method_info(const std::string& name);
 struct StepOutcome {
   std::string problem;  // non-empty: the lab's step said it could not be done
   int iterations = 0;   // iterations (sweeps, PD or Newton iterations) done; 1 for a direct solve
+  // The linear solver behind the step: "none" for the iterative methods, or
+  // the factorization (common/sparse.h's backend names, "sparse-lu", and
+  // "quasi-definite-ldlt" for lab 07's KKT solve with every compliance > 0).
+  std::string linear_solver = "none";
 };
 
 class Stepper {

@@ -112,6 +112,7 @@ double rms_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 
 struct Run {
   std::string scene, method;
+  std::string linear_solver;  // what the method's step factored with (StepOutcome)
   int iterations = 0, iterations_done = 0, repeats = 0, horizon_steps = 0;
   double step_seconds = 0, setup_seconds = 0;
   double max_strain = 0, rms_strain = 0, distance = 0, distance_max = 0, relative_distance = 0;
@@ -187,11 +188,12 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
   const cl::bench::StepOutcome outcome = pd->step(ref.after);
   if (!outcome.problem.empty()) throw std::runtime_error(scene.name + ": reference: " + outcome.problem);
   Eigen::Matrix3Xd x = ref.after.x;
-  cl::SpdFactorization factor;
+  cl::SpdFactorization factor;  // the backend for the size (common/sparse.h)
+  cl::lab06::HessianAssembly hessian(problem);
   double g = cl::lab06::objective(problem, x, y);
   for (int k = 1; k <= 50; ++k) {
     const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
-    if (!factor.refactor(cl::lab06::newton_hessian(problem, x))) break;
+    if (!factor.refactor(hessian.update(problem, x))) break;
     const Eigen::VectorXd step = factor.solve(-gradient);
     const double slope = gradient.dot(step);
     double alpha = 1.0;
@@ -344,6 +346,7 @@ int run(const Options& options) {
             one = state;
             r.iterations_done = outcome.iterations;
             r.problem = outcome.problem;
+            r.linear_solver = outcome.linear_solver;
           }
           if (!outcome.problem.empty() || times.front() > 2.0 * cap) break;  // slow: one timing will do
         }
@@ -391,7 +394,7 @@ int run(const Options& options) {
   progress.clear();
 
   // ---------------------------------------------------------------- output
-  cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "iterations", "iterations_done",
+  cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
                       "step_seconds", "seconds_per_iteration", "repeats", "setup_seconds", "max_strain", "rms_strain",
                       "distance_rms", "distance_max", "relative_distance", "horizon_steps", "energy_drift",
                       "energy_drift_rel", "on_front", "problem"});
@@ -402,7 +405,7 @@ int run(const Options& options) {
     const cl::bench::MethodInfo& method = cl::bench::method_info(r.method);
     const SceneInfo& info = info_of(r.scene);
     table.add_row({r.scene, info.particles, info.springs, r.method, std::string(cl::bench::family_name(method.family)),
-                   method.lab, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
+                   method.lab, r.linear_solver, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
                    r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
                    r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance,
                    static_cast<long long>(r.horizon_steps), r.energy_drift, r.energy_drift_rel,

@@ -1,9 +1,14 @@
 #include "common/sparse.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#ifdef CL_HAVE_CHOLMOD
+#include <cholmod.h>
+#endif
 
 namespace cl {
 
@@ -65,6 +70,101 @@ void scatter_stacked(const Eigen::VectorXd& stacked, const MovableMap& map, Eige
   }
 }
 
+const char* backend_name(SpdBackend backend) {
+  switch (backend) {
+    case SpdBackend::kSimplicial: return "simplicial-ldlt";
+    case SpdBackend::kSupernodal: return "supernodal-llt";
+    case SpdBackend::kAutomatic: break;
+  }
+  return "automatic";
+}
+
+#ifdef CL_HAVE_CHOLMOD
+bool cholmod_available() { return true; }
+
+// One CHOLMOD workspace and factor per SpdFactorization that uses it.
+struct SpdFactorization::Cholmod {
+  cholmod_common common;
+  cholmod_factor* factor = nullptr;
+  Cholmod() {
+    cholmod_start(&common);
+    common.print = 0;  // library code never prints: failures are return values here
+    common.supernodal = CHOLMOD_SUPERNODAL;
+  }
+  ~Cholmod() {
+    if (factor != nullptr) cholmod_free_factor(&factor, &common);
+    cholmod_finish(&common);
+  }
+  Cholmod(const Cholmod&) = delete;
+  Cholmod& operator=(const Cholmod&) = delete;
+};
+
+namespace {
+
+// CHOLMOD's view of a compressed Eigen matrix (no copy): its lower triangle.
+cholmod_sparse view_of(const SparseMatrix& a) {
+  cholmod_sparse view{};
+  view.nrow = static_cast<std::size_t>(a.rows());
+  view.ncol = static_cast<std::size_t>(a.cols());
+  view.nzmax = static_cast<std::size_t>(a.nonZeros());
+  view.p = const_cast<int*>(a.outerIndexPtr());
+  view.i = const_cast<int*>(a.innerIndexPtr());
+  view.x = const_cast<double*>(a.valuePtr());
+  view.stype = -1;
+  view.itype = CHOLMOD_INT;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  view.sorted = 1;
+  view.packed = 1;
+  return view;
+}
+
+// Solves A X = B for B's columns (column-major, n × columns) in place.
+void cholmod_solve_columns(cholmod_factor* factor, cholmod_common& common, double* data, Eigen::Index rows,
+                           Eigen::Index columns) {
+  cholmod_dense b{};
+  b.nrow = static_cast<std::size_t>(rows);
+  b.ncol = static_cast<std::size_t>(columns);
+  b.nzmax = b.nrow * b.ncol;
+  b.d = b.nrow;
+  b.x = data;
+  b.xtype = CHOLMOD_REAL;
+  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor, &b, &common);
+  if (x == nullptr) throw std::runtime_error("SpdFactorization: CHOLMOD's solve failed (out of memory?)");
+  std::copy(static_cast<const double*>(x->x), static_cast<const double*>(x->x) + rows * columns, data);
+  cholmod_free_dense(&x, &common);
+}
+
+}  // namespace
+#else
+bool cholmod_available() { return false; }
+struct SpdFactorization::Cholmod {};
+#endif
+
+namespace {
+std::atomic<long long> simplicial_count{0}, supernodal_count{0};
+}  // namespace
+
+SpdBackendCounts spd_backend_counts() {
+  SpdBackendCounts counts;
+  counts.simplicial = simplicial_count.load();
+  counts.supernodal = supernodal_count.load();
+  return counts;
+}
+
+double SpdFactorization::Ldlt::flops() const {
+  double sum = 0.0;
+  for (Eigen::Index j = 0; j < m_nonZerosPerCol.size(); ++j) {
+    const double below = static_cast<double>(m_nonZerosPerCol[j]);
+    sum += below * below;
+  }
+  return sum;
+}
+
+SpdFactorization::SpdFactorization(SpdBackend choice) : choice_(choice) {}
+SpdFactorization::~SpdFactorization() = default;
+
 bool SpdFactorization::factor(const SparseMatrix& a) {
   ++factorizations_;
   ok_ = false;
@@ -80,11 +180,41 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
     copy.makeCompressed();
     matrix = &copy;
   }
-  ldlt_.analyzePattern(*matrix);
+  analyzed_outer_.clear();
+  analyzed_inner_.clear();
+  backend_ = SpdBackend::kSimplicial;
+#ifdef CL_HAVE_CHOLMOD
+  // kAutomatic with CHOLMOD: CHOLMOD's analysis first (its column counts give
+  // the flop count), Eigen's only if the count is small, so that a large
+  // matrix is analysed once. Below kSmallest rows even a dense factor has
+  // fewer than kSupernodalFlops flops (n³/3): Eigen's analysis alone.
+  constexpr Eigen::Index kSmallest = 300;
+  if (choice_ == SpdBackend::kSupernodal || (choice_ == SpdBackend::kAutomatic && matrix->rows() >= kSmallest)) {
+    if (!cholmod_) cholmod_ = std::make_unique<Cholmod>();
+    if (cholmod_->factor != nullptr) cholmod_free_factor(&cholmod_->factor, &cholmod_->common);
+    cholmod_sparse view = view_of(*matrix);
+    cholmod_->factor = cholmod_analyze(&view, &cholmod_->common);
+    if (cholmod_->factor == nullptr) return false;
+    const int* counts = static_cast<const int*>(cholmod_->factor->ColCount);
+    flops_ = 0.0;
+    for (std::size_t j = 0; j < cholmod_->factor->n; ++j) {
+      const double below = static_cast<double>(counts[j] - 1);
+      flops_ += below * below;
+    }
+    if (choice_ == SpdBackend::kSupernodal || flops_ >= kSupernodalFlops) {
+      backend_ = SpdBackend::kSupernodal;
+    } else {
+      cholmod_free_factor(&cholmod_->factor, &cholmod_->common);  // Eigen's, below
+    }
+  }
+#endif
+  if (backend_ == SpdBackend::kSimplicial) {
+    ldlt_.analyzePattern(*matrix);
+    flops_ = ldlt_.flops();
+  }
   analyzed_outer_.assign(matrix->outerIndexPtr(), matrix->outerIndexPtr() + matrix->outerSize() + 1);
   analyzed_inner_.assign(matrix->innerIndexPtr(), matrix->innerIndexPtr() + matrix->nonZeros());
-  ldlt_.factorize(*matrix);
-  return accept_pivots(a.rows());
+  return numeric(*matrix);
 }
 
 bool SpdFactorization::same_pattern(const SparseMatrix& a) const {
@@ -100,8 +230,36 @@ bool SpdFactorization::refactor(const SparseMatrix& a) {
   ++factorizations_;
   ok_ = false;
   size_ = 0;
-  ldlt_.factorize(a);
-  return accept_pivots(a.rows());
+  return numeric(a);
+}
+
+bool SpdFactorization::numeric(const SparseMatrix& a) {
+  if (backend_ == SpdBackend::kSimplicial) {
+    ++simplicial_count;
+    ldlt_.factorize(a);
+    return accept_pivots(a.rows());
+  }
+#ifdef CL_HAVE_CHOLMOD
+  ++supernodal_count;
+  cholmod_sparse view = view_of(a);
+  cholmod_factor* factor = cholmod_->factor;
+  // Not positive definite: CHOLMOD stops at column `minor` < n.
+  if (!cholmod_factorize(&view, factor, &cholmod_->common) || cholmod_->common.status != CHOLMOD_OK ||
+      factor->minor < factor->n) {
+    return false;
+  }
+  // (min_j L_jj / max_j L_jj)² = min d / max d of the LDLᵀ form: the same floor
+  // as accept_pivots. NaN fails the comparison too.
+  const double rcond = cholmod_rcond(factor, &cholmod_->common);
+  if (!(rcond > static_cast<double>(a.rows()) * 1e-15)) return false;
+  values_.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
+  ldlt_stale_ = true;
+  ok_ = true;
+  size_ = a.rows();
+  return true;
+#else
+  return false;
+#endif
 }
 
 bool SpdFactorization::accept_pivots(Eigen::Index rows) {
@@ -127,8 +285,25 @@ void SpdFactorization::require_factor(Eigen::Index rows) const {
   }
 }
 
+const Eigen::SimplicialLDLT<SparseMatrix>& SpdFactorization::eigen() const {
+  if (backend_ == SpdBackend::kSupernodal && ok_ && ldlt_stale_) {
+    const Eigen::Map<const SparseMatrix> matrix(size_, size_, static_cast<Eigen::Index>(values_.size()),
+                                                analyzed_outer_.data(), analyzed_inner_.data(), values_.data());
+    ldlt_.compute(SparseMatrix(matrix));
+    ldlt_stale_ = false;
+  }
+  return ldlt_;
+}
+
 RowsX3 SpdFactorization::solve3(const RowsX3& b) const {
   require_factor(b.rows());
+#ifdef CL_HAVE_CHOLMOD
+  if (backend_ == SpdBackend::kSupernodal) {
+    Eigen::MatrixX3d columns = b;  // CHOLMOD's dense layout: column-major
+    cholmod_solve_columns(cholmod_->factor, cholmod_->common, columns.data(), columns.rows(), 3);
+    return columns;
+  }
+#endif
   // A = Pᵀ L D Lᵀ P with L unit lower triangular, stored without its diagonal.
   // y = P b; L z = y; w = D⁻¹ z; Lᵀ u = w; x = Pᵀ u — each loop over L's
   // columns moves all three coordinates together.
@@ -172,6 +347,13 @@ RowsX3 SpdFactorization::solve3(const RowsX3& b) const {
 
 Eigen::VectorXd SpdFactorization::solve(const Eigen::VectorXd& b) const {
   require_factor(b.rows());
+#ifdef CL_HAVE_CHOLMOD
+  if (backend_ == SpdBackend::kSupernodal) {
+    Eigen::VectorXd x = b;
+    cholmod_solve_columns(cholmod_->factor, cholmod_->common, x.data(), x.rows(), 1);
+    return x;
+  }
+#endif
   return ldlt_.solve(b);
 }
 

@@ -2,7 +2,9 @@
 // Sparse tools shared by the implicit labs (06 projective dynamics, 07 KKT and
 // Schur, 09 geometric stiffness): which particles are unknowns, assembly from
 // triplets, and one symmetric positive definite factorization reused for many
-// solves. Derivations: labs/lab06_projective_dynamics/README.md.
+// solves (Eigen's simplicial LDLᵀ, or CHOLMOD's supernodal LLᵀ for large
+// factors). Derivations: labs/lab06_projective_dynamics/README.md.
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -44,45 +46,106 @@ void scatter_rows(const RowsX3& rows, const MovableMap& map, Eigen::Matrix3Xd& v
 Eigen::VectorXd gather_stacked(const Eigen::Matrix3Xd& values, const MovableMap& map);
 void scatter_stacked(const Eigen::VectorXd& stacked, const MovableMap& map, Eigen::Matrix3Xd& values);
 
-// A sparse LDLᵀ factorization (Eigen's SimplicialLDLT, AMD ordering) of a
-// symmetric positive definite matrix, kept for many solves.
+// Which factorization holds an SpdFactorization's factor.
+//   kSimplicial  Eigen's SimplicialLDLT with an AMD ordering: one column of L at
+//                a time. No dependency, and the fastest for small factors.
+//   kSupernodal  CHOLMOD's supernodal LLᵀ (SuiteSparse): columns of L with the
+//                same pattern are grouped into dense blocks factored by the BLAS
+//                (level 3), so it is only as fast as the BLAS it links
+//                (OpenBLAS on Debian: libopenblas-dev). Only when the suite was
+//                built with CHOLMOD (cholmod_available()); otherwise kSimplicial.
+//   kAutomatic   kSupernodal when CHOLMOD is available and the factorization's
+//                flop count is at least kSupernodalFlops, else kSimplicial.
+enum class SpdBackend { kSimplicial, kSupernodal, kAutomatic };
+const char* backend_name(SpdBackend backend);  // "simplicial-ldlt", "supernodal-llt", "automatic"
+// True when the suite was built with CHOLMOD (Debian's libsuitesparse-dev).
+bool cholmod_available();
+// The flop count (Σ_j c_j², c_j the entries of L below the diagonal in column
+// j, in CHOLMOD's ordering) from which kAutomatic takes the supernodal
+// factorization. Measured with bench/bench_lab06 (BM_FactorBackends, CPU
+// time, OpenBLAS): PD's A at 64² (4·10⁶) factors faster with Eigen, Newton's
+// Hessian at 32² (1.2·10⁷) twice as fast with CHOLMOD, 6× at 128² (10⁹).
+inline constexpr double kSupernodalFlops = 1e7;
+
+// How many numeric factorizations each backend has done in this process, over
+// every SpdFactorization: for the bench's record of which one ran.
+struct SpdBackendCounts {
+  long long simplicial = 0, supernodal = 0;
+};
+SpdBackendCounts spd_backend_counts();
+
+// A sparse factorization of a symmetric positive definite matrix, kept for
+// many solves: Eigen's simplicial LDLᵀ or CHOLMOD's supernodal LLᵀ (above).
+// Both answer the same questions the same way; only their speed differs.
 class SpdFactorization {
  public:
+  explicit SpdFactorization(SpdBackend choice = SpdBackend::kAutomatic);
+  ~SpdFactorization();
+  SpdFactorization(const SpdFactorization&) = delete;  // neither factor is copied
+  SpdFactorization& operator=(const SpdFactorization&) = delete;
+
   // Factors `a` (square, symmetric; the lower triangle is read). Returns false,
   // and keeps no factor, when `a` is not positive definite to working
-  // precision (a pivot of D that is not finite and > 0), e.g. a singular Schur
+  // precision (a pivot of D, or the square of a diagonal entry of L, that is
+  // not finite and > n·1e-15 times the largest), e.g. a singular Schur
   // complement. Counts every call in factorizations().
   bool factor(const SparseMatrix& a);
   // The same for a matrix whose values changed but whose sparsity pattern did
   // not (Newton's Hessian, a KKT matrix): the ordering and symbolic analysis
-  // of the last factor() are reused and only the numeric factorization is
-  // redone. When the pattern differs (or nothing was factored yet) it is
-  // factor(a). Counts in factorizations() like factor().
+  // of the last factor() (and its choice of backend) are reused and only the
+  // numeric factorization is redone. When the pattern differs (or nothing was
+  // factored yet) it is factor(a). Counts in factorizations() like factor().
   bool refactor(const SparseMatrix& a);
   bool ok() const { return ok_; }
   int factorizations() const { return factorizations_; }
   Eigen::Index size() const { return size_; }
+  SpdBackend choice() const { return choice_; }
+  // The backend of the last analysis: kSimplicial or kSupernodal (kSimplicial
+  // before any).
+  SpdBackend backend() const { return backend_; }
+  // The last analysis's flop count (as kSupernodalFlops counts it, in the
+  // ordering of the backend that analysed last); 0 before any.
+  double flops() const { return flops_; }
 
-  // Solves A X = B for three right-hand sides at once in ONE pass over the
-  // factor: each entry of L is loaded once and applied to all three columns.
+  // Solves A X = B for three right-hand sides at once. Simplicial: ONE pass
+  // over the factor, each entry of L loaded once and applied to all three
+  // columns; supernodal: CHOLMOD's blocked solve of the three columns.
   // Throws std::logic_error without a factor and std::invalid_argument when B
   // has the wrong number of rows.
   RowsX3 solve3(const RowsX3& b) const;
   // One right-hand side. Same errors.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
 
-  // Eigen's own object, e.g. to compare with Eigen's column-by-column solve.
-  const Eigen::SimplicialLDLT<SparseMatrix>& eigen() const { return ldlt_; }
+  // Eigen's own object, e.g. to compare with Eigen's column-by-column solve or
+  // to solve many columns at once. When CHOLMOD holds the factor, Eigen's of
+  // the same matrix is computed at the first call after each factorization
+  // (the cost of a second factorization; ask for SpdBackend::kSimplicial to
+  // avoid it).
+  const Eigen::SimplicialLDLT<SparseMatrix>& eigen() const;
 
  private:
+  // SimplicialLDLT with its symbolic analysis's column counts readable (the flop count).
+  class Ldlt : public Eigen::SimplicialLDLT<SparseMatrix> {
+   public:
+    double flops() const;
+  };
+  struct Cholmod;  // CHOLMOD's state (common/sparse.cpp); null unless used
+
   void require_factor(Eigen::Index rows) const;
   bool same_pattern(const SparseMatrix& a) const;
+  bool numeric(const SparseMatrix& a);
   bool accept_pivots(Eigen::Index rows);
 
-  Eigen::SimplicialLDLT<SparseMatrix> ldlt_;
+  SpdBackend choice_;
+  SpdBackend backend_ = SpdBackend::kSimplicial;
+  mutable Ldlt ldlt_;              // supernodal: computed by eigen() on demand
+  mutable bool ldlt_stale_ = false;  // supernodal: ldlt_ is not this factor's
+  std::vector<double> values_;     // supernodal: the factored values, for eigen()
+  std::unique_ptr<Cholmod> cholmod_;
   bool ok_ = false;
   int factorizations_ = 0;
   Eigen::Index size_ = 0;
+  double flops_ = 0.0;
   // The pattern the symbolic analysis was made for (compressed column arrays).
   std::vector<int> analyzed_outer_, analyzed_inner_;
 };

@@ -22,13 +22,6 @@ bool decrease_below(double previous, double current, double tolerance) {
   return previous - current < tolerance * previous;
 }
 
-// Adds a 3×3 block at unknowns (a, b) of a stacked matrix.
-void add_block(std::vector<Triplet>& triplets, int a, int b, const Eigen::Matrix3d& block) {
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * a + r, 3 * b + c, block(r, c));
-  }
-}
-
 // The unit direction of x_i − x_j and its length; (1, 0, 0) for coincident ends.
 double direction(const Eigen::Matrix3Xd& x, const Spring& spring, Eigen::Vector3d& unit) {
   const Eigen::Vector3d edge = x.col(spring.i) - x.col(spring.j);
@@ -80,40 +73,104 @@ Eigen::VectorXd newton_gradient(const Problem& problem, const Eigen::Matrix3Xd& 
   return gradient;
 }
 
-SparseMatrix newton_hessian(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp) {
-  const MovableMap& map = problem.map;
-  const double inv_dt2 = 1.0 / (problem.dt * problem.dt);
-  std::vector<Triplet> triplets;
-  triplets.reserve(3 * static_cast<std::size_t>(map.unknowns()) + 36 * problem.springs.size());
-  for (int u = 0; u < map.unknowns(); ++u) {
-    const double diagonal = inv_dt2 / problem.inv_mass[map.particle_of[static_cast<std::size_t>(u)]];
-    for (int r = 0; r < 3; ++r) triplets.emplace_back(3 * u + r, 3 * u + r, diagonal);
+namespace {
+
+// Spring e's 3×3 block of the Hessian at x: k [n nᵀ + across (I − n nᵀ)].
+Eigen::Matrix3d spring_block(const Eigen::Matrix3Xd& x, const Spring& spring, bool clamp) {
+  Eigen::Vector3d unit;
+  const double length = direction(x, spring, unit);
+  // Across the spring: 1 − L/l, negative when it is compressed; clamped to 0.
+  double across = 1.0;
+  if (spring.rest_length > 0.0 && length > 0.0) {
+    across = 1.0 - spring.rest_length / length;
+    if (clamp) across = std::max(0.0, across);
+  } else if (spring.rest_length > 0.0) {
+    across = 0.0;
   }
+  const Eigen::Matrix3d along = unit * unit.transpose();
+  return spring.stiffness * (along + across * (Eigen::Matrix3d::Identity() - along));
+}
+
+constexpr int kSlotsPerSpring = 36;  // blocks aa, bb, ab, ba, each 3 × 3 column-major
+
+}  // namespace
+
+HessianAssembly::HessianAssembly(const Problem& problem) {
+  const MovableMap& map = problem.map;
+  const Eigen::Index size = 3 * static_cast<Eigen::Index>(map.unknowns());
+  std::vector<Triplet> pattern;
+  pattern.reserve(static_cast<std::size_t>(size) + 36 * problem.springs.size());
+  for (Eigen::Index k = 0; k < size; ++k) pattern.emplace_back(k, k, 0.0);
+  auto add_block = [&](int a, int b) {
+    for (int c = 0; c < 3; ++c) {
+      for (int r = 0; r < 3; ++r) pattern.emplace_back(3 * a + r, 3 * b + c, 0.0);
+    }
+  };
   for (const Spring& spring : problem.springs) {
     const int a = map.unknown_of[static_cast<std::size_t>(spring.i)];
     const int b = map.unknown_of[static_cast<std::size_t>(spring.j)];
-    if (a < 0 && b < 0) continue;
-    Eigen::Vector3d unit;
-    const double length = direction(x, spring, unit);
-    // Across the spring: 1 − L/l, negative when it is compressed; clamped to 0.
-    double across = 1.0;
-    if (spring.rest_length > 0.0 && length > 0.0) {
-      across = 1.0 - spring.rest_length / length;
-      if (clamp) across = std::max(0.0, across);
-    } else if (spring.rest_length > 0.0) {
-      across = 0.0;
-    }
-    const Eigen::Matrix3d along = unit * unit.transpose();
-    const Eigen::Matrix3d block =
-        spring.stiffness * (along + across * (Eigen::Matrix3d::Identity() - along));
-    if (a >= 0) add_block(triplets, a, a, block);
-    if (b >= 0) add_block(triplets, b, b, block);
+    if (a >= 0) add_block(a, a);
+    if (b >= 0) add_block(b, b);
     if (a >= 0 && b >= 0) {
-      add_block(triplets, a, b, -block);
-      add_block(triplets, b, a, -block);
+      add_block(a, b);
+      add_block(b, a);
     }
   }
-  return assemble(3 * map.unknowns(), 3 * map.unknowns(), triplets);
+  matrix_.resize(size, size);
+  matrix_.setFromTriplets(pattern.begin(), pattern.end());  // explicit zeros are kept: the pattern
+  matrix_.makeCompressed();
+  const int* outer = matrix_.outerIndexPtr();
+  const int* inner = matrix_.innerIndexPtr();
+  auto index_of = [&](int row, int col) {
+    return static_cast<int>(std::lower_bound(inner + outer[col], inner + outer[col + 1], row) - inner);
+  };
+  diagonal_.resize(static_cast<std::size_t>(size));
+  for (int k = 0; k < static_cast<int>(size); ++k) diagonal_[static_cast<std::size_t>(k)] = index_of(k, k);
+  slots_.assign(kSlotsPerSpring * problem.springs.size(), -1);
+  for (std::size_t e = 0; e < problem.springs.size(); ++e) {
+    const int a = map.unknown_of[static_cast<std::size_t>(problem.springs[e].i)];
+    const int b = map.unknown_of[static_cast<std::size_t>(problem.springs[e].j)];
+    int* slot = slots_.data() + kSlotsPerSpring * e;
+    const int rows[4] = {a, b, a, b};
+    const int cols[4] = {a, b, b, a};
+    for (int block = 0; block < 4; ++block) {
+      if (rows[block] < 0 || cols[block] < 0) continue;
+      for (int c = 0; c < 3; ++c) {
+        for (int r = 0; r < 3; ++r) slot[9 * block + 3 * c + r] = index_of(3 * rows[block] + r, 3 * cols[block] + c);
+      }
+    }
+  }
+}
+
+const SparseMatrix& HessianAssembly::update(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp) {
+  const MovableMap& map = problem.map;
+  if (matrix_.rows() != 3 * static_cast<Eigen::Index>(map.unknowns()) ||
+      slots_.size() != kSlotsPerSpring * problem.springs.size()) {
+    throw std::invalid_argument("HessianAssembly::update: the problem is not the one the pattern was made for");
+  }
+  const double inv_dt2 = 1.0 / (problem.dt * problem.dt);
+  double* value = matrix_.valuePtr();
+  std::fill(value, value + matrix_.nonZeros(), 0.0);
+  for (int u = 0; u < map.unknowns(); ++u) {
+    const double diagonal = inv_dt2 / problem.inv_mass[map.particle_of[static_cast<std::size_t>(u)]];
+    for (int r = 0; r < 3; ++r) value[diagonal_[static_cast<std::size_t>(3 * u + r)]] += diagonal;
+  }
+  for (std::size_t e = 0; e < problem.springs.size(); ++e) {
+    const int* slot = slots_.data() + kSlotsPerSpring * e;
+    if (slot[0] < 0 && slot[9] < 0) continue;  // both ends pinned
+    const Eigen::Matrix3d block = spring_block(x, problem.springs[e], clamp);
+    const double sign[4] = {1.0, 1.0, -1.0, -1.0};
+    for (int b = 0; b < 4; ++b) {
+      if (slot[9 * b] < 0) continue;
+      for (int k = 0; k < 9; ++k) value[slot[9 * b + k]] += sign[b] * block.data()[k];
+    }
+  }
+  return matrix_;
+}
+
+SparseMatrix newton_hessian(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp) {
+  HessianAssembly assembly(problem);
+  return assembly.update(problem, x, clamp);
 }
 
 // ------------------------------------------------------------------ the solver
@@ -126,6 +183,10 @@ Solver::Solver(Problem problem, Method method) : problem_(std::move(problem)), m
   factor_seconds_ += timer.seconds();
   ++factorizations_;
   if (!ok) setup_problem_ = "the system matrix A = M/dt^2 + sum k S^T S is not positive definite to working precision";
+}
+
+const char* Solver::linear_solver() const {
+  return backend_name(method_ == Method::kNewton ? hessian_factor_.backend() : factor_.backend());
 }
 
 StepReport Solver::step(Particles& particles, const StepSettings& settings, const IterationCallback& on_iteration) {
@@ -238,7 +299,8 @@ StepReport Solver::newton(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
       report.problem = where + "the gradient is not finite";
       break;
     }
-    const SparseMatrix hessian = newton_hessian(problem_, x);
+    if (hessian_.empty()) hessian_ = HessianAssembly(problem_);
+    const SparseMatrix& hessian = hessian_.update(problem_, x);
     const Timer timer;
     const bool ok = hessian_factor_.refactor(hessian);
     factor_seconds_ += timer.seconds();

@@ -5,6 +5,7 @@
 // the functions of projective_dynamics.h stay stateless.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -53,6 +54,28 @@ struct StepReport {
   std::string problem;       // non-empty: the step could not be done; the particles are unchanged
 };
 
+// Newton's Hessian (newton_hessian, below) assembled into a fixed sparsity
+// pattern, values only: the pattern, and where each spring's four 3×3 blocks
+// and each unknown's mass go in it, are found once (the constructor); update()
+// rewrites the values in place, with no triplets and no sort. A spring's blocks are stored even where
+// their values are 0, so the pattern is the same for every x, and the
+// factorization's ordering and symbolic analysis hold for every iteration.
+class HessianAssembly {
+ public:
+  HessianAssembly() = default;  // empty(): no pattern yet
+  explicit HessianAssembly(const Problem& problem);
+  bool empty() const { return matrix_.rows() == 0 && slots_.empty(); }
+  // newton_hessian(problem, x, clamp), written into the pattern. `problem`
+  // must be the constructor's (same unknowns and springs: std::invalid_argument
+  // otherwise). The reference stays valid until the next update.
+  const SparseMatrix& update(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp = true);
+
+ private:
+  SparseMatrix matrix_;        // full (both triangles), compressed
+  std::vector<int> diagonal_;  // per unknown: 3 value indices of its diagonal entries
+  std::vector<int> slots_;     // per spring: 36 value indices (blocks aa, bb, ab, ba; −1: a pinned end)
+};
+
 // One scene's solver. Projective dynamics factors A = system_matrix(problem)
 // once, here; Newton factors its Hessian afresh in every iteration (a new
 // numeric factorization; the fill-reducing ordering depends only on the
@@ -72,6 +95,9 @@ class Solver {
   const Problem& problem() const { return problem_; }
   int factorizations() const { return factorizations_; }
   double factor_seconds() const { return factor_seconds_; }  // total wall time spent factoring
+  // The factorization the method uses: common/sparse.h's backend_name of its
+  // factor (PD: A's; Newton: the Hessian's, "simplicial-ldlt" before the first).
+  const char* linear_solver() const;
   const std::string& setup_problem() const { return setup_problem_; }
 
  private:
@@ -82,9 +108,10 @@ class Solver {
 
   Problem problem_;
   Method method_;
-  SpdFactorization factor_;          // PD: A, kept for the whole scene
+  SpdFactorization factor_{SpdBackend::kSimplicial};  // PD: A, kept for the whole scene (one-pass solve3)
   SpdFactorization hessian_factor_;  // Newton: refactored every iteration (the pattern's
                                      // ordering and symbolic analysis are kept)
+  HessianAssembly hessian_;          // Newton: the Hessian's fixed pattern
   int factorizations_ = 0;
   double factor_seconds_ = 0.0;
   std::string setup_problem_;

@@ -46,11 +46,20 @@ KktSystem kkt_system(const LinearizedStep& step) {
   not_implemented("kkt_system", __FILE__);
 }
 
-// TODO(lab07.3) [2 pts] Solve the KKT system with Eigen::SparseLU (LU with
-// partial pivoting: the matrix is not symmetric, and indefinite once
-// symmetrised, so Cholesky or LDLᵀ without pivoting is not safe). Split the
+// TODO(lab07.3) [2 pts] Solve the KKT system. When every c_e > 0, negating
+// the constraint rows makes it S = [M, −ΔtJᵀ; −ΔtJ, −C], symmetric
+// quasi-definite, whose LDLᵀ needs no pivoting in any order (README.md,
+// "Method 1"). Take the order "multipliers first": with H the upper-left
+// block and B = ΔtJ the lower-left one (the upper right is −Bᵀ), factor
+// R = H + Bᵀ C⁻¹ B with cl::SpdFactorization, solve R v_new = b₁ + Bᵀ C⁻¹ b₂,
+// then λ = C⁻¹ (b₂ − B v_new). Otherwise (some c_e = 0: a zero on the
+// diagonal of the lower-right block), or when that factorization refuses or
+// its answer misses, use Eigen::SparseLU, LU with partial pivoting, on the
+// matrix as written. Tell the cases apart from the matrix: S exactly
+// symmetric, its lower-right block diagonal and < 0, its upper-left block
+// with a positive diagonal that dominates each of its rows. Split the
 // solution: the first velocity_unknowns entries are v_new, the rest λ.
-// On a failed factorization (lu.info()), a non-finite solution z, or one that
+// On a failed factorization (info()), a non-finite solution z, or one that
 // misses the system, ‖Az − b‖∞ > 1e-8 (‖A‖∞‖z‖∞ + ‖b‖∞), return ok = false
 // and a one-line problem (never NaN). Throw std::invalid_argument when the matrix
 // is not square, the rhs has the wrong size, or velocity_unknowns is outside

@@ -91,13 +91,26 @@ SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Sp
 // an inverse mass is not finite or ≤ 0.
 KktSystem kkt_system(const LinearizedStep& step);
 
-// TODO(lab07.3) — the primal-dual solve: factor system.matrix with a sparse LU
-// with pivoting (Eigen::SparseLU; the matrix is not symmetric as written and
-// is indefinite once symmetrised) and solve. `velocity_unknowns` is 3u: the
+// TODO(lab07.3) — the primal-dual solve. With every c_e > 0, negating the
+// constraint rows makes the matrix symmetric quasi-definite,
+//     S = [M, −ΔtJᵀ; −ΔtJ, −C]   (M and C positive definite),
+// which has an LDLᵀ in any symmetric ordering with no pivoting (Vanderbei
+// 1995; README.md). Take the multipliers first: with H the upper-left block
+// and B = ΔtJ the lower-left one, factor R = H + Bᵀ C⁻¹ B (SPD) with
+// cl::SpdFactorization, v_new = R⁻¹ (b₁ + Bᵀ C⁻¹ b₂), λ = C⁻¹ (b₂ − B v_new).
+// With some c_e = 0 the lower-right block is singular and S is not
+// quasi-definite: factor system.matrix with a sparse LU with partial
+// pivoting (Eigen::SparseLU), as also when R is refused or its answer
+// misses. Tell the two apart from the matrix: S exactly symmetric, its
+// lower-right block diagonal with every entry < 0, and its upper-left block
+// with a positive diagonal that strictly dominates each of its rows
+// (positive definite by Gershgorin; lab 09's M − Δt²K_g need not be).
+// `velocity_unknowns` is 3u: the
 // first 3u entries of the solution are v_new, the rest λ. Returns ok = false
 // with a problem line (never NaN) when the factorization fails, the solution
 // z is not finite, or it misses the system, ‖Az − b‖∞ > 1e-8 (‖A‖∞‖z‖∞ +
-// ‖b‖∞) (a pivot that is zero only up to round-off). A redundant but
+// ‖b‖∞) (a pivot that is zero only up to round-off); the LDLᵀ's answer that
+// misses is not final: the LU decides. A redundant but
 // consistent set of hard constraints can still pass: v_new is then right (it
 // is unique) and λ one of infinitely many splits (README.md). Throws
 // std::invalid_argument when the matrix is not square, the rhs has the wrong

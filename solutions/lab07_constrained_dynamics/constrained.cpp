@@ -59,6 +59,50 @@ double row_sum_norm(const SparseMatrix& a) {
   return a.rows() > 0 ? sums.maxCoeff() : 0.0;
 }
 
+// The KKT matrix with its constraint rows negated, S = diag(I, −I) A, when S is
+// symmetric quasi-definite: S = [H, Bᵀ; B, −G] with H positive definite (a
+// positive diagonal that strictly dominates its rows: Gershgorin) and G
+// diagonal with every entry > 0 (every c_e > 0). Such an S has an LDLᵀ in any
+// symmetric ordering, no pivoting (README.md, Vanderbei 1995). Returns false,
+// leaving `symmetric` unspecified, otherwise (a hard constraint, c_e = 0).
+bool quasi_definite_form(const SparseMatrix& a, Eigen::Index velocity_unknowns, SparseMatrix& symmetric) {
+  const Eigen::Index n = velocity_unknowns;
+  const Eigen::Index size = a.rows();
+  symmetric = a;
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(size);
+  Eigen::VectorXd off_diagonal = Eigen::VectorXd::Zero(size);  // Σ |H_rc|, c ≠ r, rows of H only
+  for (int c = 0; c < symmetric.outerSize(); ++c) {
+    for (SparseMatrix::InnerIterator it(symmetric, c); it; ++it) {
+      if (it.row() >= n) it.valueRef() = -it.value();
+      const bool lower_right = it.row() >= n && it.col() >= n;
+      if (it.row() == it.col()) {
+        diagonal[it.row()] = it.value();
+      } else if (lower_right) {
+        return false;  // G is not diagonal
+      } else if (it.row() < n && it.col() < n) {
+        off_diagonal[it.row()] += std::abs(it.value());
+      }
+    }
+  }
+  for (Eigen::Index k = 0; k < size; ++k) {
+    if (k < n ? !(diagonal[k] > off_diagonal[k]) : !(diagonal[k] < 0.0)) return false;
+  }
+  // Symmetric exactly: kkt_system writes ΔtJ and −ΔtJᵀ from the same values.
+  const SparseMatrix difference = symmetric - SparseMatrix(symmetric.transpose());
+  for (Eigen::Index k = 0; k < difference.nonZeros(); ++k) {
+    if (difference.valuePtr()[k] != 0.0) return false;
+  }
+  return true;
+}
+
+// True when z solves A z = b to the tolerance of the contract (a pivot that is
+// zero only up to round-off gives a finite z that misses the system).
+bool solves(const SparseMatrix& a, const Eigen::VectorXd& z, const Eigen::VectorXd& b, double& residual) {
+  residual = a.rows() > 0 ? (a * z - b).cwiseAbs().maxCoeff() : 0.0;
+  return a.rows() == 0 ||
+         residual <= 1e-8 * (row_sum_norm(a) * z.cwiseAbs().maxCoeff() + b.cwiseAbs().maxCoeff());
+}
+
 // g repeated for every unknown.
 Eigen::VectorXd stacked_gravity(const LinearizedStep& step) {
   return step.gravity.replicate(step.velocity.size() / 3, 1);
@@ -140,7 +184,41 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
                                 " is outside [0, " + std::to_string(size) + "]");
   }
   StepSolution solution;
-  // LU with partial pivoting: correct for a non-symmetric, indefinite matrix.
+  auto accept = [&](const Eigen::VectorXd& unknowns) {
+    solution.velocity = unknowns.head(velocity_unknowns);
+    solution.lambda = unknowns.tail(size - velocity_unknowns);
+    solution.ok = true;
+    return solution;
+  };
+  double residual = 0.0;
+  // Every c_e > 0: the LDLᵀ of the symmetric quasi-definite form S in the
+  // order "multipliers first". Their pivots are −c_e and they fill nothing
+  // among themselves; what is left for the velocities is
+  //     R = H + (ΔtJ)ᵀ C⁻¹ (ΔtJ)   (H = M, or lab 09's M − Δt²K_g),
+  // symmetric positive definite, factored by SpdFactorization (CHOLMOD's
+  // supernodal LLᵀ when it is large). Should it refuse, or round-off defeat
+  // the answer, the LU below decides.
+  SparseMatrix symmetric;
+  if (size > velocity_unknowns && quasi_definite_form(system.matrix, velocity_unknowns, symmetric)) {
+    const Eigen::Index n = velocity_unknowns;
+    const Eigen::Index m = size - n;
+    const SparseMatrix upper_left = system.matrix.topLeftCorner(n, n);
+    const SparseMatrix lower_left = system.matrix.bottomLeftCorner(m, n);  // ΔtJ; the upper right is −(ΔtJ)ᵀ
+    const Eigen::VectorXd inverse_compliance = system.matrix.diagonal().tail(m).cwiseInverse();
+    const SparseMatrix lower_left_transpose = lower_left.transpose();
+    const SparseMatrix reduced =
+        upper_left + lower_left_transpose * (inverse_compliance.asDiagonal() * lower_left);
+    SpdFactorization factor;
+    if (factor.factor(reduced)) {
+      const Eigen::VectorXd scaled = inverse_compliance.cwiseProduct(system.rhs.tail(m));  // C⁻¹ b₂
+      Eigen::VectorXd unknowns(size);
+      unknowns.head(n) = factor.solve(system.rhs.head(n) + lower_left_transpose * scaled);
+      unknowns.tail(m) = scaled - inverse_compliance.cwiseProduct(lower_left * unknowns.head(n));
+      if (unknowns.allFinite() && solves(system.matrix, unknowns, system.rhs, residual)) return accept(unknowns);
+    }
+  }
+  // Some c_e = 0 (the lower-right block is singular): LU with partial pivoting,
+  // correct for any non-singular matrix.
   Eigen::SparseLU<SparseMatrix, Eigen::COLAMDOrdering<int>> lu;
   lu.analyzePattern(system.matrix);
   lu.factorize(system.matrix);
@@ -153,19 +231,12 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
     solution.problem = "the KKT matrix is singular (the LU solve is not finite)";
     return solution;
   }
-  // A pivot that is zero only up to round-off gives a finite answer; when the
-  // system has no solution that answer does not satisfy it.
-  const double residual = (system.matrix * unknowns - system.rhs).cwiseAbs().maxCoeff();
-  if (size > 0 && !(residual <= 1e-8 * (row_sum_norm(system.matrix) * unknowns.cwiseAbs().maxCoeff() +
-                                         system.rhs.cwiseAbs().maxCoeff()))) {
+  if (!solves(system.matrix, unknowns, system.rhs, residual)) {
     solution.problem = "the KKT matrix is singular (the LU solution misses the system by " +
                        std::to_string(residual) + ")";
     return solution;
   }
-  solution.velocity = unknowns.head(velocity_unknowns);
-  solution.lambda = unknowns.tail(size - velocity_unknowns);
-  solution.ok = true;
-  return solution;
+  return accept(unknowns);
 }
 
 StepSolution solve_schur(const LinearizedStep& step) {
