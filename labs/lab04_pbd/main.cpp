@@ -13,7 +13,6 @@
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/metrics.h"
-#include "common/obj.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "pbd.h"
@@ -63,24 +62,17 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "kinetic", "potential", "total_energy",
-                      "seconds", "status"});
-  int frames_written = 0;
-  const cl::lab04::FrameCallback on_frame = [&](const cl::lab04::FrameRecord& record, const cl::Particles& state) {
-    const std::string& problem = record.problem;
-    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
-                   record.kinetic, record.potential, record.kinetic + record.potential, record.seconds,
-                   problem.empty() ? std::string("ok") : "diverged: " + problem});
-    const bool last = record.frame == scene.steps;
-    if (lab.frames_every > 0 && problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
-      cl::write_frame_obj(frames_dir, kLab, scene, state.x, record.frame, record.time);
-      ++frames_written;
-    }
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = cl::lab04::frame_columns();
+  output.obj_every = lab.frames_every;
+  output.obj_dir = frames_dir;
+  output.lab = kLab;
+  output.scene = &scene;
 
   cl::Particles& particles = scene.particles;
   const cl::lab04::RunResult result =
-      cl::lab04::run_frames(particles, constraints, settings, lab.substeps, plan, on_frame);
+      cl::lab04::run_frames(particles, constraints, settings, lab.substeps, plan, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const double kinetic = cl::kinetic_energy(particles);
   const double potential = cl::potential_energy(particles, scene.gravity);
@@ -111,9 +103,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
   if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
   std::printf("\n");
-  if (frames_written > 0) std::printf("  %d OBJ frames in %s\n", frames_written, frames_dir.c_str());
+  if (result.obj_frames > 0) std::printf("  %d OBJ frames in %s\n", result.obj_frames, frames_dir.c_str());
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
