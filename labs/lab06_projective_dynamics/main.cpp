@@ -86,19 +86,11 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.iterations = options.iterations;
   settings.tolerance = lab.tolerance;
 
-  cl::CsvTable table({"step", "time", "objective", "iterations", "converged", "failed_decreases", "seconds",
-                      "max_strain", "rms_strain", "kinetic", "potential", "elastic", "total_energy", "status"});
-  const cl::lab06::StepCallback on_step = [&](const cl::lab06::StepRecord& record, const cl::Particles&) {
-    table.add_row({static_cast<long long>(record.step), record.time, record.report.objective,
-                   static_cast<long long>(record.report.iterations_done),
-                   static_cast<long long>(record.report.converged ? 1 : 0),
-                   static_cast<long long>(record.report.failed_decreases), record.report.seconds, record.strain.max,
-                   record.strain.rms, record.kinetic, record.potential, record.elastic,
-                   record.kinetic + record.potential + record.elastic,
-                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
+  output.columns = cl::lab06::step_columns();
   cl::Particles& particles = scene.particles;
-  const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, on_step);
+  const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const bool diverged = !result.problem.empty();
 
@@ -126,7 +118,6 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   std::printf("\n");
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_step.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary =
         cl::stepping_summary(kLab, cl::lab06::method_name(method), scene, particles, strain, result.seconds);

@@ -62,17 +62,12 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "total_stretch", "kinetic", "potential",
-                      "elastic", "total_energy", "seconds", "status"});
-  const cl::lab08::FrameCallback on_frame = [&](const cl::lab08::FrameRecord& record, const cl::Particles&) {
-    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
-                   record.total_stretch, record.kinetic, record.potential, record.elastic,
-                   record.kinetic + record.potential + record.elastic, record.seconds,
-                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = cl::lab08::frame_columns();
 
   cl::Particles& particles = scene.particles;
-  const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, on_frame);
+  const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const double stretch = cl::lab08::total_stretch(particles.x, scene.springs);
   const double kinetic = cl::kinetic_energy(particles);
@@ -113,7 +108,6 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
   std::printf("\n");
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
