@@ -103,8 +103,16 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  DIVERGED at step %d (t = %.4g s): %s\n", result.problem_step, result.problem_step * scene.dt,
                 result.problem.c_str());
   } else {
-    std::printf("  final:   objective %.6e J, max strain %.3e, rms %.3e\n", result.objective, strain.max,
-                strain.rms);
+    // A spring of rest length 0 has no strain: strain_stats counts its length (m).
+    const auto zero_rest = std::count_if(scene.springs.begin(), scene.springs.end(),
+                                         [](const cl::Spring& spring) { return spring.rest_length == 0.0; });
+    if (zero_rest > 0 && zero_rest == static_cast<std::ptrdiff_t>(scene.springs.size())) {
+      std::printf("  final:   objective %.6e J, max spring length %.3e m, rms %.3e m (rest length 0: no strain)\n",
+                  result.objective, strain.max, strain.rms);
+    } else {
+      std::printf("  final:   objective %.6e J, max strain %.3e, rms %.3e%s\n", result.objective, strain.max,
+                  strain.rms, zero_rest > 0 ? " (a spring of rest length 0 counts its length, m)" : "");
+    }
     std::printf("  energy:  total %.6e J (start %.6e J)\n", result.energy_end, result.energy_start);
   }
   if (result.failed_decreases > 0) {
