@@ -14,6 +14,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -127,7 +128,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const std::string outside = band_problem(result, limit, lab, options.iterations);
   if (!outside.empty()) std::printf("  WARNING: %s\n", outside.c_str());
-  std::printf("  time %.3e s: %.3e s per step\n", result.seconds, per_step(result));
+  cl::print_time(result.seconds, result.steps_done, "step");
+  std::printf("\n");
   // A limited run whose energy rose past the scene's scale and did not stop:
   // only the limiter holds it (README.md, "Bounded only by the limiter").
   const bool contained = limit != Limit::kNone && result.energy_exceeded_step >= 0 && !diverged;

@@ -12,6 +12,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -103,9 +104,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
-  std::printf("  time %.3e s: %.3e s per frame", result.seconds,
-              result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
-  if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
+  cl::print_time(result.seconds, result.frames_done, "frame", projections, "spring projection");
   std::printf("\n");
 
   if (!options.summary.empty()) {
@@ -152,30 +151,16 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
 
-  std::vector<int> ks = lab.sweep_iterations;
+  const std::vector<int>& ks = lab.sweep_iterations;
   std::vector<cl::lab08::RunResult> results(ks.size());
-  std::vector<std::size_t> by_cost(ks.size());
-  for (std::size_t r = 0; r < ks.size(); ++r) by_cost[r] = r;
-  std::stable_sort(by_cost.begin(), by_cost.end(), [&](std::size_t a, std::size_t b) { return ks[a] > ks[b]; });
-
-  std::exception_ptr failure;
-  const auto count = static_cast<long>(ks.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long k = 0; k < count; ++k) {
-    const std::size_t r = by_cost[static_cast<std::size_t>(k)];
-    try {
-      cl::Particles particles = scene.particles;
-      cl::lab08::RunPlan plan;
-      plan.frames = scene.steps;
-      plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
-      plan.settle_tolerance = lab.settle_tolerance;
-      results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
-    } catch (...) {
-#pragma omp critical(lab08_sweep_failure)
-      if (!failure) failure = std::current_exception();
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  cl::run_shared(cl::costliest_first(std::vector<double>(ks.begin(), ks.end())), [&](std::size_t r) {
+    cl::Particles particles = scene.particles;
+    cl::lab08::RunPlan plan;
+    plan.frames = scene.steps;
+    plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
+    plan.settle_tolerance = lab.settle_tolerance;
+    results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
+  });
 
   cl::CsvTable table({"scene", "method", "dt", "substeps", "iterations", "frames_run", "time_run", "window_seconds",
                       "steady_total_stretch", "material_total_stretch", "stiffness_ratio", "steady_max_strain",
