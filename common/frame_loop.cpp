@@ -57,6 +57,14 @@ class FrameWriter {
 
 }  // namespace
 
+FramePlan frame_plan(int frames, double dt, double energy_scale) {
+  FramePlan plan;
+  plan.frames = frames;
+  plan.dt = dt;
+  plan.energy_scale = energy_scale;
+  return plan;
+}
+
 FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const MeasureFunction& measure,
                                const FramePlan& plan, const FrameOutput& output, const FrameHook& on_frame) {
   if (plan.frames < 0 || plan.window_frames < 0 || !(plan.settle_tolerance >= 0.0)) {

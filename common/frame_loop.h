@@ -122,6 +122,10 @@ struct FrameLoopResult {
   int obj_frames = 0;                // OBJ files written
 };
 
+// The plan most labs start from: `frames` frames of `dt` s, the energy verdict
+// stopping a rise above `energy_scale` J, no windows.
+FramePlan frame_plan(int frames, double dt, double energy_scale);
+
 // Runs the loop on `state` (which the step function changes). `on_frame`, if
 // set, is called for every judged frame before the output (the lab's own
 // per-frame callback). Throws std::invalid_argument for frames < 0,
@@ -130,5 +134,27 @@ struct FrameLoopResult {
 FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const MeasureFunction& measure,
                                const FramePlan& plan, const FrameOutput& output = {},
                                const FrameHook& on_frame = nullptr);
+
+// For a lab whose own per-frame callback takes its record and the state: the
+// hook that writes the frame's verdict into record.problem and then calls
+// `callback` (when set). `record` and `callback` must outlive the loop.
+template <class Record, class Callback>
+FrameHook record_hook(Record& record, const Callback& callback) {
+  return [&record, &callback](const FrameEvent& event) {
+    record.problem = event.problem;
+    if (callback) callback(record, event.state);
+  };
+}
+
+// Copies the outcome every lab's result reports alike: the frames (or steps)
+// done into `done`, the wall time into result.seconds, the problem into
+// result.problem and its frame into `at`.
+template <class Result>
+void copy_outcome(const FrameLoopResult& run, Result& result, int& done, int& at) {
+  done = run.frames_done;
+  result.seconds = run.seconds;
+  result.problem = run.problem;
+  at = run.problem_frame;
+}
 
 }  // namespace cl

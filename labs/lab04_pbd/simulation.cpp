@@ -25,10 +25,7 @@ RunResult run_frames(Particles& particles, const ConstraintSet& constraints, con
   }
   RunResult result;
   result.energy_scale = energy_scale(particles, frame.gravity, frame.dt);
-  FramePlan loop;
-  loop.frames = plan.frames;
-  loop.dt = frame.dt;
-  loop.energy_scale = result.energy_scale;
+  FramePlan loop = frame_plan(plan.frames, frame.dt, result.energy_scale);
   loop.window_frames = plan.window_frames;
   loop.settle_tolerance = plan.settle_tolerance;
   loop.settle_not_before = plan.energy_frame;
@@ -54,13 +51,9 @@ RunResult run_frames(Particles& particles, const ConstraintSet& constraints, con
                         {record.strain.max, record.strain.rms, record.kinetic, record.potential, total, seconds},
                         {}};
   };
-  auto judged = [&](const FrameEvent& event) {
-    record.problem = event.problem;
-    if (on_frame) on_frame(record, particles);
-  };
-  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, judged);
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, record_hook(record, on_frame));
 
-  result.frames_done = run.frames_done;
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
   result.windows_done = run.windows_done;
   if (run.windows_done > 0) {
     result.window_max_strain = run.window_means[0];
@@ -72,9 +65,6 @@ RunResult run_frames(Particles& particles, const ConstraintSet& constraints, con
   result.energy_start = run.energy_start;
   result.energy_end = run.energy_end;
   result.max_energy_rise = run.max_energy_rise;
-  result.seconds = run.seconds;
-  result.problem = run.problem;
-  result.problem_frame = run.problem_frame;
   result.obj_frames = run.obj_frames;
   return result;
 }

@@ -179,10 +179,7 @@ RunResult run_steps(Particles& particles, const LimitedSystem& system, const Ste
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0 (got " + std::to_string(steps) + ")");
   RunResult result;
   result.energy_scale = energy_scale(particles, settings.gravity, settings.dt);
-  FramePlan loop;
-  loop.frames = steps;
-  loop.dt = settings.dt;
-  loop.energy_scale = result.energy_scale;
+  FramePlan loop = frame_plan(steps, settings.dt, result.energy_scale);
   loop.energy_verdict = check_energy ? EnergyVerdict::kStop : EnergyVerdict::kReport;
 
   StepRecord record;
@@ -218,22 +215,15 @@ RunResult run_steps(Particles& particles, const LimitedSystem& system, const Ste
     if (!std::isfinite(record.elastic + record.kinetic)) measured.problem = "energy is not finite";
     return measured;
   };
-  auto judged = [&](const FrameEvent& event) {
-    record.problem = event.problem;
-    if (on_step) on_step(record, particles);
-  };
   FrameOutput with_index = output;
   with_index.index_column = "step";
   with_index.problem_prefix = "unstable: ";
-  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, with_index, judged);
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, with_index, record_hook(record, on_step));
 
-  result.steps_done = run.frames_done;
+  copy_outcome(run, result, result.steps_done, result.problem_step);
   result.energy_start = run.energy_start;
   result.energy_end = run.energy_end;
   result.max_energy_rise = run.max_energy_rise;
-  result.seconds = run.seconds;
-  result.problem = run.problem;
-  result.problem_step = run.problem_frame;
   result.energy_exceeded_step = run.energy_exceeded_frame;
   result.energy_exceeded = run.energy_exceeded;
   return result;

@@ -338,9 +338,6 @@ RunResult run_steps(Particles& particles, Solver& solver, const StepSettings& se
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
   const Problem& problem = solver.problem();
   RunResult result;
-  FramePlan loop;
-  loop.frames = steps;
-  loop.dt = problem.dt;
 
   StepRecord record;
   StepReport report;
@@ -363,25 +360,19 @@ RunResult run_steps(Particles& particles, Solver& solver, const StepSettings& se
                          total},
                         {}};
   };
-  auto judged = [&](const FrameEvent& event) {
-    record.problem = event.problem;
-    if (on_step) on_step(record, particles);
-  };
   // The scale needs the initial elastic energy, which the loop measures first:
   // measure frame 0 once here for it (measuring changes nothing).
   const StepRecord start = measure(0, 0.0, particles, problem, settings.gravity);
-  loop.energy_scale = energy_scale(particles, settings.gravity, problem.dt) + start.elastic;
+  const FramePlan loop =
+      frame_plan(steps, problem.dt, energy_scale(particles, settings.gravity, problem.dt) + start.elastic);
   FrameOutput with_index = output;
   with_index.index_column = "step";
-  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, with_index, judged);
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, with_index, record_hook(record, on_step));
 
-  result.steps_done = run.frames_done;
+  copy_outcome(run, result, result.steps_done, result.problem_step);
   result.energy_start = run.energy_start;
   result.energy_end = run.energy_end;
   result.energy_scale = loop.energy_scale;
-  result.seconds = run.seconds;
-  result.problem = run.problem;
-  result.problem_step = run.problem_frame;
   return result;
 }
 

@@ -157,10 +157,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                              potential, elastic, total, frame > 0 ? solve_seconds : 0.0, projection_seconds},
                             {}};
   };
-  cl::FramePlan plan;
-  plan.frames = scene.steps;
-  plan.dt = scene.dt;
-  plan.energy_scale = scale;
+  const cl::FramePlan plan = cl::frame_plan(scene.steps, scene.dt, scale);
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = {"max_constraint_error", "max_strain", "kinetic", "potential", "spring_energy", "total_energy",

@@ -106,10 +106,7 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
   }
   RunResult result;
   result.energy_scale = energy_scale(particles, frame.gravity, frame.dt);
-  FramePlan loop;
-  loop.frames = plan.frames;
-  loop.dt = frame.dt;
-  loop.energy_scale = result.energy_scale;
+  FramePlan loop = frame_plan(plan.frames, frame.dt, result.energy_scale);
   loop.energy_name = "kinetic + potential energy";
   loop.window_frames = plan.window_frames;
   loop.settle_tolerance = plan.settle_tolerance;
@@ -131,13 +128,9 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
                          record.elastic, total(record), seconds},
                         {}};
   };
-  auto judged = [&](const FrameEvent& event) {
-    record.problem = event.problem;
-    if (on_frame) on_frame(record, particles);
-  };
-  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, output, judged);
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, output, record_hook(record, on_frame));
 
-  result.frames_done = run.frames_done;
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
   result.windows_done = run.windows_done;
   if (run.windows_done > 0) {
     result.window_total_stretch = run.window_means[0];
@@ -145,9 +138,6 @@ RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constrain
   }
   result.window_spread = run.window_spread;
   result.settled = run.settled;
-  result.seconds = run.seconds;
-  result.problem = run.problem;
-  result.problem_frame = run.problem_frame;
   return result;
 }
 

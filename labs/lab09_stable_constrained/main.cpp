@@ -131,10 +131,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                              elastic, kinetic + potential + elastic, seconds},
                             {}};
   };
-  cl::FramePlan plan;
-  plan.frames = scene.steps;
-  plan.dt = scene.dt;
-  plan.energy_scale = scale;
+  const cl::FramePlan plan = cl::frame_plan(scene.steps, scene.dt, scale);
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = {"max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda", "kinetic",

@@ -60,10 +60,7 @@ RunResult run_frames(Particles& particles, const ClothHierarchy& hierarchy, cons
   if (frames < 0) throw std::invalid_argument("run_frames: frames must be >= 0 (got " + std::to_string(frames) + ")");
   if (hierarchy.levels.empty()) throw std::invalid_argument("run_frames: the hierarchy has no levels");
   RunResult result;
-  FramePlan loop;
-  loop.frames = frames;
-  loop.dt = settings.dt;
-  loop.energy_scale = energy_scale(particles, settings.gravity, settings.dt);
+  const FramePlan loop = frame_plan(frames, settings.dt, energy_scale(particles, settings.gravity, settings.dt));
 
   const long long per_step = projections_per_pass(hierarchy, settings.iterations);
   FrameRecord record;
@@ -87,17 +84,10 @@ RunResult run_frames(Particles& particles, const ClothHierarchy& hierarchy, cons
                         {record.strain.max, record.strain.rms, record.kinetic, record.potential, total, seconds},
                         {}};
   };
-  auto judged = [&](const FrameEvent& event) {
-    record.problem = event.problem;
-    if (on_frame) on_frame(record, particles);
-  };
-  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, judged);
-  result.frames_done = run.frames_done;
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, record_hook(record, on_frame));
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
   result.energy_start = run.energy_start;
   result.energy_end = run.energy_end;
-  result.seconds = run.seconds;
-  result.problem = run.problem;
-  result.problem_frame = run.problem_frame;
   result.obj_frames = run.obj_frames;
   return result;
 }

@@ -45,6 +45,15 @@ struct Kicked {
   }
 };
 
+// Output asking for the history in frame_loop_test_out/FILE.
+cl::FrameOutput history_in(const std::string& file) {
+  const std::string dir = "frame_loop_test_out";
+  cl::ensure_directory(dir);
+  cl::FrameOutput output;
+  output.csv_path = cl::join_path(dir, file);
+  return output;
+}
+
 std::vector<std::string> lines_of(const std::string& path) {
   std::ifstream in(path);
   std::vector<std::string> lines;
@@ -144,13 +153,8 @@ TEST_CASE("a step that could not be taken stops the run, is not counted, and kee
           "[common][frame_loop]") {
   Kicked run;
   run.kick = 0.0;
-  cl::FramePlan plan;
-  plan.frames = 10;
-  plan.dt = 0.1;
-  const std::string dir = "frame_loop_test_out";
-  cl::ensure_directory(dir);
-  cl::FrameOutput output;
-  output.csv_path = cl::join_path(dir, "per_frame.csv");
+  const cl::FramePlan plan = cl::frame_plan(10, 0.1, 0.0);
+  cl::FrameOutput output = history_in("per_frame.csv");
   output.columns = {"speed"};
   const cl::FrameLoopResult result = cl::run_frame_loop(
       run.state,
@@ -171,13 +175,8 @@ TEST_CASE("a step's own problem is prefixed in the history; the loop's clock or 
           "[common][frame_loop]") {
   Kicked run;
   run.kick = 0.0;
-  cl::FramePlan plan;
-  plan.frames = 5;
-  plan.dt = 1.0;
-  const std::string dir = "frame_loop_test_out";
-  cl::ensure_directory(dir);
-  cl::FrameOutput output;
-  output.csv_path = cl::join_path(dir, "per_step.csv");
+  const cl::FramePlan plan = cl::frame_plan(5, 1.0, 0.0);
+  cl::FrameOutput output = history_in("per_step.csv");
   output.index_column = "step";
   output.problem_prefix = "unstable: ";
   const cl::FrameLoopResult result = cl::run_frame_loop(
