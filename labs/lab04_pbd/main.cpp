@@ -5,15 +5,14 @@
 //   --sweep-substeps 1,2,...,64 --cost C    substeps × K = C fixed   -> substeps.csv
 #include <algorithm>
 #include <cstdio>
-#include <exception>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
-#include "common/obj.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "pbd.h"
@@ -63,24 +62,17 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "kinetic", "potential", "total_energy",
-                      "seconds", "status"});
-  int frames_written = 0;
-  const cl::lab04::FrameCallback on_frame = [&](const cl::lab04::FrameRecord& record, const cl::Particles& state) {
-    const std::string& problem = record.problem;
-    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
-                   record.kinetic, record.potential, record.kinetic + record.potential, record.seconds,
-                   problem.empty() ? std::string("ok") : "diverged: " + problem});
-    const bool last = record.frame == scene.steps;
-    if (lab.frames_every > 0 && problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
-      cl::write_frame_obj(frames_dir, kLab, scene, state.x, record.frame, record.time);
-      ++frames_written;
-    }
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = cl::lab04::frame_columns();
+  output.obj_every = lab.frames_every;
+  output.obj_dir = frames_dir;
+  output.lab = kLab;
+  output.scene = &scene;
 
   cl::Particles& particles = scene.particles;
   const cl::lab04::RunResult result =
-      cl::lab04::run_frames(particles, constraints, settings, lab.substeps, plan, on_frame);
+      cl::lab04::run_frames(particles, constraints, settings, lab.substeps, plan, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const double kinetic = cl::kinetic_energy(particles);
   const double potential = cl::potential_energy(particles, scene.gravity);
@@ -107,13 +99,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
-  std::printf("  time %.3e s: %.3e s per frame", result.seconds,
-              result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
-  if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
+  cl::print_time(result.seconds, result.frames_done, "frame", projections, "spring projection");
   std::printf("\n");
-  if (frames_written > 0) std::printf("  %d OBJ frames in %s\n", frames_written, frames_dir.c_str());
+  if (result.obj_frames > 0) std::printf("  %d OBJ frames in %s\n", result.obj_frames, frames_dir.c_str());
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
@@ -154,13 +143,7 @@ std::string status_of(const cl::lab04::RunResult& result) {
 // wall time is its own.
 int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
               const std::vector<std::pair<int, int>>& points, const std::string& csv_name) {
-  std::vector<cl::Scene> scenes;
-  for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene}
-                                                          : lab.sweep_scenes) {
-    cl::CommonOptions one = options;
-    one.scene = name;
-    scenes.push_back(cl::load_scene_for(one, CL_LAB_SCENE_DIR));
-  }
+  const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, CL_LAB_SCENE_DIR);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   std::vector<cl::lab04::ConstraintSet> constraints;
   for (const cl::Scene& scene : scenes) {
@@ -168,38 +151,25 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
   }
 
   std::vector<SweepRun> runs;
+  std::vector<double> costs;
   for (std::size_t s = 0; s < scenes.size(); ++s) {
-    for (const auto& [substeps, iterations] : points) runs.push_back({s, substeps, iterations, {}});
-  }
-  std::vector<std::size_t> by_cost(runs.size());
-  for (std::size_t r = 0; r < runs.size(); ++r) by_cost[r] = r;
-  auto cost = [&](const SweepRun& run) {
-    return static_cast<double>(scenes[run.scene].springs.size() + 1) * run.substeps * std::max(run.iterations, 1);
-  };
-  std::stable_sort(by_cost.begin(), by_cost.end(),
-                   [&](std::size_t a, std::size_t b) { return cost(runs[a]) > cost(runs[b]); });
-
-  std::exception_ptr failure;
-  const auto count = static_cast<long>(runs.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long k = 0; k < count; ++k) {
-    SweepRun& run = runs[by_cost[static_cast<std::size_t>(k)]];
-    const cl::Scene& scene = scenes[run.scene];
-    try {
-      cl::Particles particles = scene.particles;
-      cl::lab04::RunPlan plan;
-      plan.frames = scene.steps;
-      plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
-      plan.settle_tolerance = lab.settle_tolerance;
-      plan.energy_frame = cl::frames_in(lab.energy_seconds, scene.dt);
-      run.result = cl::lab04::run_frames(particles, constraints[run.scene],
-                                         frame_settings(scene, options, lab, run.iterations), run.substeps, plan);
-    } catch (...) {
-#pragma omp critical(lab04_sweep_failure)
-      if (!failure) failure = std::current_exception();
+    for (const auto& [substeps, iterations] : points) {
+      runs.push_back({s, substeps, iterations, {}});
+      costs.push_back(static_cast<double>(scenes[s].springs.size() + 1) * substeps * std::max(iterations, 1));
     }
   }
-  if (failure) std::rethrow_exception(failure);
+  cl::run_shared(cl::costliest_first(costs), [&](std::size_t r) {
+    SweepRun& run = runs[r];
+    const cl::Scene& scene = scenes[run.scene];
+    cl::Particles particles = scene.particles;
+    cl::lab04::RunPlan plan;
+    plan.frames = scene.steps;
+    plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
+    plan.settle_tolerance = lab.settle_tolerance;
+    plan.energy_frame = cl::frames_in(lab.energy_seconds, scene.dt);
+    run.result = cl::lab04::run_frames(particles, constraints[run.scene],
+                                       frame_settings(scene, options, lab, run.iterations), run.substeps, plan);
+  });
 
   cl::CsvTable table({"scene", "nx", "ny", "particles", "springs", "method", "dt", "substeps", "iterations",
                       "frames_run", "time_run", "window_seconds", "steady_max_strain", "steady_rms_strain",

@@ -5,8 +5,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "common/timer.h"
-#include "common/window_means.h"
 
 namespace cl::lab04 {
 
@@ -20,74 +18,60 @@ void advance_frame(Particles& particles, const ConstraintSet& constraints, const
   for (int s = 0; s < substeps; ++s) pbd_step(particles, constraints, step);
 }
 
-namespace {
-FrameRecord measure(int frame, double time, const Particles& particles, const ConstraintSet& constraints,
-                    const Eigen::Vector3d& gravity, double seconds) {
-  FrameRecord record;
-  record.frame = frame;
-  record.time = time;
-  record.strain = strain_stats(particles.x, constraints.springs);
-  record.kinetic = kinetic_energy(particles);
-  record.potential = potential_energy(particles, gravity);
-  record.seconds = seconds;
-  return record;
-}
-}  // namespace
-
 RunResult run_frames(Particles& particles, const ConstraintSet& constraints, const PbdSettings& frame, int substeps,
-                     const RunPlan& plan, const FrameCallback& on_frame) {
+                     const RunPlan& plan, const FrameCallback& on_frame, const FrameOutput& output) {
   if (plan.frames < 0 || plan.window_frames < 1 || !(plan.settle_tolerance >= 0.0)) {
     throw std::invalid_argument("run_frames: needs frames >= 0, window_frames >= 1, settle_tolerance >= 0");
   }
   RunResult result;
   result.energy_scale = energy_scale(particles, frame.gravity, frame.dt);
-  FrameRecord record = measure(0, 0.0, particles, constraints, frame.gravity, 0.0);
-  result.energy_start = record.kinetic + record.potential;
-  result.energy_end = result.energy_start;
-  if (plan.energy_frame == 0) result.energy_at_mark = result.energy_start;
-  record.problem = health_problem(particles, record.strain);
-  if (on_frame) on_frame(record, particles);
-  result.problem = record.problem;
-  if (!result.problem.empty()) {
-    result.problem_frame = 0;
-    return result;
-  }
+  FramePlan loop = frame_plan(plan.frames, frame.dt, result.energy_scale);
+  loop.window_frames = plan.window_frames;
+  loop.settle_tolerance = plan.settle_tolerance;
+  loop.settle_not_before = plan.energy_frame;
 
-  WindowMeans max_strain(plan.window_frames), rms_strain(plan.window_frames);
-  for (int f = 1; f <= plan.frames; ++f) {
-    const Timer timer;
+  FrameRecord record;
+  auto step = [&](int) {
     advance_frame(particles, constraints, frame, substeps);
-    const double seconds = timer.seconds();
-    result.seconds += seconds;
-    record = measure(f, f * frame.dt, particles, constraints, frame.gravity, seconds);
-    result.frames_done = f;
-    result.energy_end = record.kinetic + record.potential;
-    if (f == plan.energy_frame) result.energy_at_mark = result.energy_end;
-    const double rise = result.energy_end - result.energy_start;
-    result.max_energy_rise = std::max(result.max_energy_rise, rise);
-    record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty()) record.problem = energy_rise_problem(rise, result.energy_scale);
-    if (on_frame) on_frame(record, particles);
-    result.problem = record.problem;
-    if (!result.problem.empty()) {
-      result.problem_frame = f;
-      return result;
-    }
-    rms_strain.add(record.strain.rms);
-    if (!max_strain.add(record.strain.max)) continue;
+    return StepVerdict{};
+  };
+  auto measure = [&](int f, double seconds) {
+    record = FrameRecord{};
+    record.frame = f;
+    record.time = f * frame.dt;
+    record.strain = strain_stats(particles.x, constraints.springs);
+    record.kinetic = kinetic_energy(particles);
+    record.potential = potential_energy(particles, frame.gravity);
+    record.seconds = seconds;
+    const double total = record.kinetic + record.potential;
+    if (f == plan.energy_frame) result.energy_at_mark = total;
+    return FrameMeasure{record.strain,
+                        total,
+                        {record.strain.max, record.strain.rms},
+                        {record.strain.max, record.strain.rms, record.kinetic, record.potential, total, seconds},
+                        {}};
+  };
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, record_hook(record, on_frame));
 
-    // A window is complete.
-    if (result.windows_done > 0) result.previous_window_max_strain = result.window_max_strain;
-    result.window_max_strain = max_strain.last();
-    result.window_rms_strain = rms_strain.last();
-    result.windows_done = max_strain.windows_done();
-    result.window_spread = max_strain.relative_spread();
-    if (max_strain.settled(plan.settle_tolerance) && f >= plan.energy_frame) {
-      result.settled = true;
-      break;
-    }
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
+  result.windows_done = run.windows_done;
+  if (run.windows_done > 0) {
+    result.window_max_strain = run.window_means[0];
+    result.window_rms_strain = run.window_means[1];
   }
+  if (!run.previous_window_means.empty()) result.previous_window_max_strain = run.previous_window_means[0];
+  result.window_spread = run.window_spread;
+  result.settled = run.settled;
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  result.max_energy_rise = run.max_energy_rise;
+  result.obj_frames = run.obj_frames;
   return result;
+}
+
+// The columns of the per-frame history that run_frames writes (FrameOutput::columns).
+std::vector<std::string> frame_columns() {
+  return {"max_strain", "rms_strain", "kinetic", "potential", "total_energy", "seconds"};
 }
 
 }  // namespace cl::lab04

@@ -3,9 +3,11 @@
 // the graded tests. It owns the state; pbd_step stays stateless.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "pbd.h"
@@ -57,16 +59,23 @@ struct RunResult {
   double seconds = 0.0;                  // wall time of all steps
   std::string problem;                   // empty unless the run diverged (it stops there)
   int problem_frame = -1;
+  int obj_frames = 0;                    // OBJ files written (FrameOutput)
 };
 
 using FrameCallback = std::function<void(const FrameRecord&, const Particles&)>;
 
-// Runs `particles` forward frame by frame (advance_frame), measuring after every
-// frame and calling `on_frame` (if set) for frame 0 and each frame after it.
-// Stops at the first unhealthy frame (health_problem, or a total energy more
-// than energy_scale above its start) and says why in RunResult::problem.
-// Potential energy is measured in frame.gravity.
+// Runs `particles` forward frame by frame (advance_frame) in common/frame_loop.h's
+// loop, measuring after every frame and calling `on_frame` (if set) for frame 0
+// and each frame after it. Stops at the first unhealthy frame (health_problem,
+// or a total energy more than energy_scale above its start) and says why in
+// RunResult::problem. Potential energy is measured in frame.gravity. `output`
+// asks the loop for the per-frame CSV (frame_columns()) and OBJ frames.
 RunResult run_frames(Particles& particles, const ConstraintSet& constraints, const PbdSettings& frame,
-                     int substeps, const RunPlan& plan, const FrameCallback& on_frame = nullptr);
+                     int substeps, const RunPlan& plan, const FrameCallback& on_frame = nullptr,
+                     const FrameOutput& output = {});
+
+// The lab's columns of the per-frame CSV: max_strain, rms_strain, kinetic,
+// potential, total_energy (J), seconds (wall time of the frame's steps).
+std::vector<std::string> frame_columns();
 
 }  // namespace cl::lab04

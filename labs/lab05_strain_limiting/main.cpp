@@ -14,6 +14,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -100,17 +101,12 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab05::StepSettings settings = step_settings(scene, options, lab, limit);
 
-  cl::CsvTable table({"step", "time", "max_strain", "min_strain", "rms_strain_error", "kinetic", "potential",
-                      "elastic", "total_energy", "seconds", "status"});
-  const cl::lab05::StepCallback on_step = [&](const cl::lab05::StepRecord& record, const cl::Particles&) {
-    table.add_row({static_cast<long long>(record.step), record.time, record.strain.max, record.strain.min,
-                   record.rms_strain_error, record.kinetic, record.potential, record.elastic,
-                   record.kinetic + record.potential + record.elastic, record.seconds,
-                   record.problem.empty() ? std::string("ok") : "unstable: " + record.problem});
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
+  output.columns = cl::lab05::step_columns();
   cl::Particles& particles = scene.particles;
   const cl::lab05::RunResult result =
-      cl::lab05::run_steps(particles, system, settings, scene.steps, checks_energy(limit), on_step);
+      cl::lab05::run_steps(particles, system, settings, scene.steps, checks_energy(limit), nullptr, output);
   const bool diverged = !result.problem.empty();
   const cl::lab05::SignedStrain strain = cl::lab05::signed_strain(particles.x, system.springs);
   const cl::StrainStats error = cl::strain_stats(particles.x, system.springs);
@@ -132,9 +128,17 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const std::string outside = band_problem(result, limit, lab, options.iterations);
   if (!outside.empty()) std::printf("  WARNING: %s\n", outside.c_str());
-  std::printf("  time %.3e s: %.3e s per step\n", result.seconds, per_step(result));
-
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_step.csv"));
+  cl::print_time(result.seconds, result.steps_done, "step");
+  std::printf("\n");
+  // A limited run whose energy rose past the scene's scale and did not stop:
+  // only the limiter holds it (README.md, "Bounded only by the limiter").
+  const bool contained = limit != Limit::kNone && result.energy_exceeded_step >= 0 && !diverged;
+  if (contained) {
+    std::fprintf(stderr, "%s: bounded only by the limiter: from step %d (t = %.4g s) the total energy rose up to "
+                 "%.3g J above its start, more than the scene's %.3g J; the run went on, held inside the band by "
+                 "the limiter alone (summary: energy_contained_by_limiter)\n", kLab, result.energy_exceeded_step,
+                 result.energy_exceeded_step * scene.dt, result.max_energy_rise, result.energy_scale);
+  }
   if (!options.summary.empty()) {
     cl::RunSummary summary =
         cl::stepping_summary(kLab, cl::lab05::limit_name(limit), scene, particles, error, result.seconds);
@@ -150,6 +154,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["seconds_per_step"] = per_step(result);
     cl::add_energies(summary, kinetic, potential, elastic, result.energy_start);
     if (limit == Limit::kSprings) summary.extra["band_held"] = outside.empty() && !diverged;
+    if (limit != Limit::kNone) summary.extra["energy_contained_by_limiter"] = contained;
+    if (contained) summary.extra["energy_contained_from_step"] = result.energy_exceeded_step;
     cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
     cl::write_summary(options.summary, summary);
   }

@@ -8,7 +8,6 @@
 #include <string>
 
 #include "common/metrics.h"
-#include "common/timer.h"
 
 namespace cl::lab05 {
 
@@ -175,69 +174,63 @@ double elastic_energy(const Eigen::Matrix3Xd& x, const std::vector<Spring>& spri
   return energy;
 }
 
-namespace {
-StepRecord measure(int step, double time, const Particles& particles, const LimitedSystem& system,
-                   const Eigen::Vector3d& gravity, double seconds) {
-  StepRecord record;
-  record.step = step;
-  record.time = time;
-  record.strain = signed_strain(particles.x, system.springs);
-  record.rms_strain_error = strain_stats(particles.x, system.springs).rms;
-  record.kinetic = kinetic_energy(particles);
-  record.potential = potential_energy(particles, gravity);
-  record.elastic = elastic_energy(particles.x, system.springs);
-  record.seconds = seconds;
-  return record;
-}
-
-double total(const StepRecord& record) { return record.kinetic + record.potential + record.elastic; }
-}  // namespace
-
 RunResult run_steps(Particles& particles, const LimitedSystem& system, const StepSettings& settings, int steps,
-                    bool check_energy, const StepCallback& on_step) {
+                    bool check_energy, const StepCallback& on_step, const FrameOutput& output) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0 (got " + std::to_string(steps) + ")");
   RunResult result;
   result.energy_scale = energy_scale(particles, settings.gravity, settings.dt);
-  StepRecord record = measure(0, 0.0, particles, system, settings.gravity, 0.0);
-  result.energy_start = result.energy_end = total(record);
-  record.problem = health_problem(particles, strain_stats(particles.x, system.springs));
-  if (on_step) on_step(record, particles);
-  if (!record.problem.empty()) {
-    result.problem = record.problem;
-    result.problem_step = 0;
-    return result;
-  }
-  for (int step = 1; step <= steps; ++step) {
-    const Timer timer;
+  FramePlan loop = frame_plan(steps, settings.dt, result.energy_scale);
+  loop.energy_verdict = check_energy ? EnergyVerdict::kStop : EnergyVerdict::kReport;
+
+  StepRecord record;
+  auto step = [&](int) {
     limited_step(particles, system, settings);
-    const double seconds = timer.seconds();
-    result.seconds += seconds;
-    record = measure(step, step * settings.dt, particles, system, settings.gravity, seconds);
-    result.steps_done = step;
-    result.energy_end = total(record);
-    const double rise = result.energy_end - result.energy_start;
-    if (rise > result.max_energy_rise) result.max_energy_rise = rise;
-    if (step == 1 || !(record.strain.max <= result.max_strain)) {
+    return StepVerdict{};
+  };
+  auto measure = [&](int s, double seconds) {
+    record = StepRecord{};
+    record.step = s;
+    record.time = s * settings.dt;
+    record.strain = signed_strain(particles.x, system.springs);
+    const StrainStats error = strain_stats(particles.x, system.springs);
+    record.rms_strain_error = error.rms;
+    record.kinetic = kinetic_energy(particles);
+    record.potential = potential_energy(particles, settings.gravity);
+    record.elastic = elastic_energy(particles.x, system.springs);
+    record.seconds = seconds;
+    const double total = record.kinetic + record.potential + record.elastic;
+    FrameMeasure measured{error, total, {},
+                          {record.strain.max, record.strain.min, record.rms_strain_error, record.kinetic,
+                           record.potential, record.elastic, total, seconds},
+                          {}};
+    if (s == 0) return measured;
+    if (s == 1 || !(record.strain.max <= result.max_strain)) {
       result.max_strain = record.strain.max;
-      result.max_strain_step = step;
+      result.max_strain_step = s;
     }
-    if (step == 1 || !(record.strain.min >= result.min_strain)) {
+    if (s == 1 || !(record.strain.min >= result.min_strain)) {
       result.min_strain = record.strain.min;
-      result.min_strain_step = step;
+      result.min_strain_step = s;
     }
-    record.problem = health_problem(particles, strain_stats(particles.x, system.springs));
-    if (record.problem.empty() && !std::isfinite(record.elastic + record.kinetic)) {
-      record.problem = "energy is not finite";
-    }
-    if (record.problem.empty() && check_energy) record.problem = energy_rise_problem(rise, result.energy_scale);
-    if (on_step) on_step(record, particles);
-    if (!record.problem.empty()) {
-      result.problem = record.problem;
-      result.problem_step = step;
-      return result;
-    }
-  }
+    if (!std::isfinite(record.elastic + record.kinetic)) measured.problem = "energy is not finite";
+    return measured;
+  };
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  with_index.problem_prefix = "unstable: ";
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, with_index, record_hook(record, on_step));
+
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  result.max_energy_rise = run.max_energy_rise;
+  result.energy_exceeded_step = run.energy_exceeded_frame;
+  result.energy_exceeded = run.energy_exceeded;
   return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"max_strain", "min_strain", "rms_strain_error", "kinetic", "potential", "elastic", "total_energy", "seconds"};
 }
 
 }  // namespace cl::lab05

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "common/constraints.h"
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/particles.h"
 #include "common/scene.h"
@@ -106,19 +107,34 @@ struct RunResult {
   double seconds = 0.0;           // wall time of all steps
   std::string problem;            // empty unless the run became unstable (it stops there)
   int problem_step = -1;
+  // A run without the energy check (check_energy false) whose total energy
+  // still rose more than energy_scale above its start: the first such step
+  // (-1: none) and common/health.h's energy_rise_problem line for it. The run
+  // went on: only the limiter kept it inside the band ("bounded only by the
+  // limiter", README.md).
+  int energy_exceeded_step = -1;
+  std::string energy_exceeded;
 };
 
 using StepCallback = std::function<void(const StepRecord&, const Particles&)>;
 
-// Runs `steps` steps, measuring after each and calling `on_step` (if set) for
-// step 0 and every step after it. Stops at the first unhealthy step and says
-// why in RunResult::problem: common/health.h's health_problem (a non-finite
-// value, or a strain error >= kUnstableStrain), or — with check_energy — a
-// total energy (kinetic + gravity + elastic) more than energy_scale above its
-// start. A limited step can hold a stiff cloth inside the band while its
-// springs store far more than that (README.md, "Bounded only by the
-// limiter"), so the driver checks energy for unlimited runs only.
+// Runs `steps` steps in common/frame_loop.h's loop, measuring after each and
+// calling `on_step` (if set) for step 0 and every step after it. Stops at the
+// first unhealthy step and says why in RunResult::problem: common/health.h's
+// health_problem (a non-finite value, or a strain error >= kUnstableStrain), a
+// non-finite energy, or — with check_energy — a total energy (kinetic +
+// gravity + elastic) more than energy_scale above its start. A limited step
+// can hold a stiff cloth inside the band while its springs store far more than
+// that (README.md, "Bounded only by the limiter"), so the driver checks energy
+// for unlimited runs only; without the check, a rise above the scale does not
+// stop the run but is reported in RunResult::energy_exceeded_step. `output`
+// asks the loop for the per-step CSV (index "step", step_columns(), status
+// "unstable: …").
 RunResult run_steps(Particles& particles, const LimitedSystem& system, const StepSettings& settings, int steps,
-                    bool check_energy, const StepCallback& on_step = nullptr);
+                    bool check_energy, const StepCallback& on_step = nullptr, const FrameOutput& output = {});
+
+// The lab's columns of the per-step CSV: max_strain, min_strain (ℓ/L − 1),
+// rms_strain_error, kinetic, potential, elastic, total_energy (J), seconds.
+std::vector<std::string> step_columns();
 
 }  // namespace cl::lab05

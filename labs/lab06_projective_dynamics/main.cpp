@@ -86,19 +86,11 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.iterations = options.iterations;
   settings.tolerance = lab.tolerance;
 
-  cl::CsvTable table({"step", "time", "objective", "iterations", "converged", "failed_decreases", "seconds",
-                      "max_strain", "rms_strain", "kinetic", "potential", "elastic", "total_energy", "status"});
-  const cl::lab06::StepCallback on_step = [&](const cl::lab06::StepRecord& record, const cl::Particles&) {
-    table.add_row({static_cast<long long>(record.step), record.time, record.report.objective,
-                   static_cast<long long>(record.report.iterations_done),
-                   static_cast<long long>(record.report.converged ? 1 : 0),
-                   static_cast<long long>(record.report.failed_decreases), record.report.seconds, record.strain.max,
-                   record.strain.rms, record.kinetic, record.potential, record.elastic,
-                   record.kinetic + record.potential + record.elastic,
-                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
+  output.columns = cl::lab06::step_columns();
   cl::Particles& particles = scene.particles;
-  const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, on_step);
+  const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const bool diverged = !result.problem.empty();
 
@@ -111,8 +103,16 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  DIVERGED at step %d (t = %.4g s): %s\n", result.problem_step, result.problem_step * scene.dt,
                 result.problem.c_str());
   } else {
-    std::printf("  final:   objective %.6e J, max strain %.3e, rms %.3e\n", result.objective, strain.max,
-                strain.rms);
+    // A spring of rest length 0 has no strain: strain_stats counts its length (m).
+    const auto zero_rest = std::count_if(scene.springs.begin(), scene.springs.end(),
+                                         [](const cl::Spring& spring) { return spring.rest_length == 0.0; });
+    if (zero_rest > 0 && zero_rest == static_cast<std::ptrdiff_t>(scene.springs.size())) {
+      std::printf("  final:   objective %.6e J, max spring length %.3e m, rms %.3e m (rest length 0: no strain)\n",
+                  result.objective, strain.max, strain.rms);
+    } else {
+      std::printf("  final:   objective %.6e J, max strain %.3e, rms %.3e%s\n", result.objective, strain.max,
+                  strain.rms, zero_rest > 0 ? " (a spring of rest length 0 counts its length, m)" : "");
+    }
     std::printf("  energy:  total %.6e J (start %.6e J)\n", result.energy_end, result.energy_start);
   }
   if (result.failed_decreases > 0) {
@@ -126,7 +126,6 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   std::printf("\n");
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_step.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary =
         cl::stepping_summary(kLab, cl::lab06::method_name(method), scene, particles, strain, result.seconds);

@@ -396,43 +396,51 @@ StepRecord measure(int step, double time, const Particles& particles, const Prob
 }  // namespace
 
 RunResult run_steps(Particles& particles, Solver& solver, const StepSettings& settings, int steps,
-                    const StepCallback& on_step) {
+                    const StepCallback& on_step, const FrameOutput& output) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
   const Problem& problem = solver.problem();
   RunResult result;
-  StepRecord record = measure(0, 0.0, particles, problem, settings.gravity);
-  result.energy_start = record.kinetic + record.potential + record.elastic;
-  result.energy_end = result.energy_start;
-  result.energy_scale = energy_scale(particles, settings.gravity, problem.dt) + record.elastic;
-  record.problem = health_problem(particles, record.strain);
-  if (on_step) on_step(record, particles);
-  if (!record.problem.empty()) {
-    result.problem = record.problem;
-    result.problem_step = 0;
-    return result;
-  }
-  for (int s = 1; s <= steps; ++s) {
-    const StepReport report = solver.step(particles, settings);
-    result.seconds += report.seconds;
+
+  StepRecord record;
+  StepReport report;
+  auto step = [&](int) {
+    report = solver.step(particles, settings);
     result.iterations_done += report.iterations_done;
     result.failed_decreases += report.failed_decreases;
-    record = measure(s, s * problem.dt, particles, problem, settings.gravity);
-    record.report = report;
-    result.steps_done = s;
     result.objective = report.objective;
-    result.energy_end = record.kinetic + record.potential + record.elastic;
-    record.problem = report.problem;
-    if (record.problem.empty()) record.problem = health_problem(particles, record.strain);
-    const double rise = result.energy_end - result.energy_start;
-    if (record.problem.empty()) record.problem = energy_rise_problem(rise, result.energy_scale);
-    if (on_step) on_step(record, particles);
-    if (!record.problem.empty()) {
-      result.problem = record.problem;
-      result.problem_step = s;
-      return result;
-    }
-  }
+    return StepVerdict{report.problem, true, report.seconds};
+  };
+  auto measured = [&](int s, double) {
+    record = measure(s, s * problem.dt, particles, problem, settings.gravity);
+    if (s > 0) record.report = report;
+    const double total = record.kinetic + record.potential + record.elastic;
+    return FrameMeasure{record.strain, total, {},
+                        {record.report.objective, static_cast<long long>(record.report.iterations_done),
+                         static_cast<long long>(record.report.converged ? 1 : 0),
+                         static_cast<long long>(record.report.failed_decreases), record.report.seconds,
+                         record.strain.max, record.strain.rms, record.kinetic, record.potential, record.elastic,
+                         total},
+                        {}};
+  };
+  // The scale needs the initial elastic energy, which the loop measures first:
+  // measure frame 0 once here for it (measuring changes nothing).
+  const StepRecord start = measure(0, 0.0, particles, problem, settings.gravity);
+  const FramePlan loop =
+      frame_plan(steps, problem.dt, energy_scale(particles, settings.gravity, problem.dt) + start.elastic);
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, with_index, record_hook(record, on_step));
+
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  result.energy_scale = loop.energy_scale;
   return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"objective", "iterations", "converged", "failed_decreases", "seconds", "max_strain", "rms_strain",
+          "kinetic", "potential", "elastic", "total_energy"};
 }
 
 }  // namespace cl::lab06

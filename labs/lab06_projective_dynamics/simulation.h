@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "common/particles.h"
@@ -154,11 +155,18 @@ struct RunResult {
   int problem_step = -1;
 };
 
-// Runs `steps` steps, measuring after each and calling on_step for step 0 and
-// every step after it. Stops at the first step that reports a problem, or
-// whose state is unhealthy (common/health.h: non-finite, strain >= 1e3), or
-// whose total energy rose more than energy_scale above its start.
+// Runs `steps` steps in common/frame_loop.h's loop, measuring after each and
+// calling on_step for step 0 and every step after it. Stops at the first step
+// that reports a problem, or whose state is unhealthy (common/health.h:
+// non-finite, strain >= 1e3), or whose total energy rose more than
+// energy_scale above its start. `output` asks the loop for the per-step CSV
+// (index "step", step_columns()).
 RunResult run_steps(Particles& particles, Solver& solver, const StepSettings& settings, int steps,
-                    const StepCallback& on_step = nullptr);
+                    const StepCallback& on_step = nullptr, const FrameOutput& output = {});
+
+// The lab's columns of the per-step CSV: objective (J), iterations, converged
+// (1/0), failed_decreases, seconds (the solver's), max_strain, rms_strain,
+// kinetic, potential, elastic, total_energy (J).
+std::vector<std::string> step_columns();
 
 }  // namespace cl::lab06

@@ -13,6 +13,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "common/output.h"
@@ -120,41 +121,18 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const double scale = cl::energy_scale(particles, scene.gravity, scene.dt);
   const bool redundant = cl::lab07::hard_constraints_redundant(particles, scene.springs, map);
 
-  cl::CsvTable table({"frame", "time", "max_constraint_error", "max_strain", "kinetic", "potential", "spring_energy",
-                      "total_energy", "step_seconds", "stabilize_seconds", "status"});
-  auto add_row = [&](int frame, double step_seconds, double stabilize_seconds, const std::string& status) {
-    const double kinetic = cl::kinetic_energy(particles);
-    const double potential = cl::potential_energy(particles, scene.gravity);
-    const double elastic = spring_energy(particles.x, scene.springs, lambda);
-    table.add_row({static_cast<long long>(frame), frame * scene.dt,
-                   cl::lab07::max_constraint_error(particles.x, scene.springs),
-                   cl::strain_stats(particles.x, scene.springs).max, kinetic, potential, elastic,
-                   kinetic + potential + elastic, step_seconds, stabilize_seconds, status});
-  };
-
-  std::string problem = check_health(particles, scene, lambda, energy_start, scale);
-  std::string outcome;  // "diverged: …" or "singular: …"
-  int problem_frame = -1;
-  add_row(0, 0.0, 0.0, problem.empty() ? "ok" : "diverged: " + problem);
-  if (!problem.empty()) {
-    outcome = "diverged: " + problem;
-    problem_frame = 0;
-  }
-  double step_seconds = 0.0, stabilize_seconds = 0.0, worst_error = 0.0, worst_before_projection = 0.0;
-  int frames_done = 0;
-  for (int f = 1; f <= scene.steps && outcome.empty(); ++f) {
+  // One step: the solve, then (--stabilize) the projection onto the hard
+  // constraints; the loop's clock times both.
+  double solve_seconds = 0.0, step_seconds = 0.0, stabilize_seconds = 0.0, projection_seconds = 0.0;
+  double worst_error = 0.0, worst_before_projection = 0.0;
+  auto step = [&](int) -> cl::StepVerdict {
+    projection_seconds = 0.0;
     const cl::Timer step_timer;
     const cl::lab07::StepResult result = cl::lab07::constrained_step(particles, scene.springs, map, settings);
-    const double seconds = step_timer.seconds();
-    step_seconds += seconds;
-    if (!result.ok) {
-      outcome = "singular: " + result.problem;
-      problem_frame = f;
-      add_row(f, seconds, 0.0, outcome);
-      break;
-    }
+    solve_seconds = step_timer.seconds();
+    step_seconds += solve_seconds;
+    if (!result.ok) return {"singular: " + result.problem, false};
     lambda = result.lambda;
-    double projection_seconds = 0.0;
     if (lab.stabilize) {
       worst_before_projection =
           std::max(worst_before_projection, cl::lab07::max_constraint_error(particles.x, scene.springs));
@@ -162,23 +140,32 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       const cl::lab07::ProjectionResult projection = cl::lab07::stabilize_positions(particles, scene.springs, map);
       projection_seconds = projection_timer.seconds();
       stabilize_seconds += projection_seconds;
-      if (!projection.ok) {
-        outcome = "singular: " + projection.problem;
-        problem_frame = f;
-        add_row(f, seconds, projection_seconds, outcome);
-        break;
-      }
+      if (!projection.ok) return {"singular: " + projection.problem, false};
     }
-    frames_done = f;
-    problem = check_health(particles, scene, lambda, energy_start, scale);
-    add_row(f, seconds, projection_seconds, problem.empty() ? "ok" : "diverged: " + problem);
-    if (!problem.empty()) {
-      outcome = "diverged: " + problem;
-      problem_frame = f;
-      break;
-    }
+    // Over every step taken, the one a run stops at included.
     worst_error = std::max(worst_error, cl::lab07::max_constraint_error(particles.x, scene.springs));
-  }
+    return {};
+  };
+  auto measure = [&](int frame, double) {
+    const double kinetic = cl::kinetic_energy(particles);
+    const double potential = cl::potential_energy(particles, scene.gravity);
+    const double elastic = spring_energy(particles.x, scene.springs, lambda);
+    const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+    const double total = kinetic + potential + elastic;
+    return cl::FrameMeasure{strain, total, {},
+                            {cl::lab07::max_constraint_error(particles.x, scene.springs), strain.max, kinetic,
+                             potential, elastic, total, frame > 0 ? solve_seconds : 0.0, projection_seconds},
+                            {}};
+  };
+  const cl::FramePlan plan = cl::frame_plan(scene.steps, scene.dt, scale);
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = {"max_constraint_error", "max_strain", "kinetic", "potential", "spring_energy", "total_energy",
+                    "step_seconds", "stabilize_seconds"};
+  const cl::FrameLoopResult run = cl::run_frame_loop(particles, step, measure, plan, output);
+  const int frames_done = run.frames_done;
+  const int problem_frame = run.problem_frame;
+  const std::string outcome = run.problem.empty() ? std::string() : run.status;  // "diverged: …" or "singular: …"
 
   const bool stopped = !outcome.empty();
   const double final_error = cl::lab07::max_constraint_error(particles.x, scene.springs);
@@ -209,19 +196,18 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  energy: %.6e J (start %.6e J)\n", energy, energy_start);
   }
   const double steps_taken = std::max(1, frames_done);
-  std::printf("  time %.3e s: %.3e s per step\n", step_seconds + stabilize_seconds, step_seconds / steps_taken);
+  std::printf("  time %.3e s: %.3e s per step%s\n", run.seconds, run.seconds / steps_taken,
+              lab.stabilize ? " (the solve and the projection)" : "");
   if (lab.stabilize) std::printf("  projection %.3e s per step (%.0f%% of the step)\n", stabilize_seconds / steps_taken,
-                                 step_seconds > 0.0 ? 100.0 * stabilize_seconds / step_seconds : 0.0);
+                                 run.seconds > 0.0 ? 100.0 * stabilize_seconds / run.seconds : 0.0);
   if (lambda.size() > 0 && lambda.size() <= 4) {
     std::printf("  multipliers (N):");
     for (Eigen::Index e = 0; e < lambda.size(); ++e) std::printf(" %.6g", lambda[e]);
     std::printf("\n");
   }
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
-    cl::RunSummary summary =
-        cl::stepping_summary(kLab, options.method, scene, particles, strain, step_seconds + stabilize_seconds);
+    cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, run.seconds);
     summary.extra["multipliers"] = std::vector<double>(lambda.data(), lambda.data() + lambda.size());
     summary.extra["max_constraint_error"] = final_error;
     summary.extra["worst_constraint_error"] = worst_error;

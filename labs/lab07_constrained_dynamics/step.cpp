@@ -73,6 +73,17 @@ LinearizedStep linearize(const Particles& particles, const std::vector<Spring>& 
   return step;
 }
 
+std::string solution_problem(const StepSolution& solution, Eigen::Index unknowns, Eigen::Index constraints) {
+  if (!solution.ok) return solution.problem.empty() ? "the solve failed without saying why" : solution.problem;
+  if (solution.velocity.size() != unknowns || solution.lambda.size() != constraints) {
+    return "the solve returned v_new or lambda of the wrong size";
+  }
+  if (!solution.velocity.allFinite() || !solution.lambda.allFinite()) {
+    return "the solve returned a non-finite v_new or lambda";
+  }
+  return {};
+}
+
 StepResult constrained_step(Particles& particles, const std::vector<Spring>& springs, const StepSettings& settings) {
   check_settings(settings);
   return constrained_step(particles, springs, make_movable_map(particles.inv_mass), settings);
@@ -88,23 +99,10 @@ StepResult constrained_step(Particles& particles, const std::vector<Spring>& spr
     solution = solve_schur(step);
   }
   StepResult result;
-  result.ok = solution.ok;
-  result.problem = solution.problem;
-  if (!solution.ok) {
-    if (result.problem.empty()) result.problem = "the solve failed without saying why";
-    return result;
-  }
-  if (solution.velocity.size() != step.velocity.size() ||
-      solution.lambda.size() != static_cast<Eigen::Index>(springs.size())) {
-    result.ok = false;
-    result.problem = "the solve returned v_new or lambda of the wrong size";
-    return result;
-  }
-  if (!solution.velocity.allFinite() || !solution.lambda.allFinite()) {
-    result.ok = false;
-    result.problem = "the solve returned a non-finite v_new or lambda";
-    return result;
-  }
+  result.problem =
+      solution_problem(solution, step.velocity.size(), static_cast<Eigen::Index>(springs.size()));
+  if (!result.problem.empty()) return result;
+  result.ok = true;
   update_positions(particles, map, solution.velocity, settings.dt);
   result.lambda = std::move(solution.lambda);
   return result;

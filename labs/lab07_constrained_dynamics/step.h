@@ -58,6 +58,13 @@ StepResult constrained_step(Particles& particles, const std::vector<Spring>& spr
 StepResult constrained_step(Particles& particles, const std::vector<Spring>& springs, const MovableMap& map,
                             const StepSettings& settings);
 
+// Empty when `solution` is a usable solve with `unknowns` velocity entries and
+// `constraints` multipliers; otherwise why not, in one line: the solve failed
+// (its own problem, or "the solve failed without saying why"), or returned
+// v_new or λ of the wrong size, or non-finite ones. Lab 09's step judges its
+// solves with it too.
+std::string solution_problem(const StepSolution& solution, Eigen::Index unknowns, Eigen::Index constraints);
+
 // max_e |φ_e| (m), 0 without springs.
 double max_constraint_error(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs);
 

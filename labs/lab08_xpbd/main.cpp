@@ -12,6 +12,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -62,17 +63,12 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "total_stretch", "kinetic", "potential",
-                      "elastic", "total_energy", "seconds", "status"});
-  const cl::lab08::FrameCallback on_frame = [&](const cl::lab08::FrameRecord& record, const cl::Particles&) {
-    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
-                   record.total_stretch, record.kinetic, record.potential, record.elastic,
-                   record.kinetic + record.potential + record.elastic, record.seconds,
-                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = cl::lab08::frame_columns();
 
   cl::Particles& particles = scene.particles;
-  const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, on_frame);
+  const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const double stretch = cl::lab08::total_stretch(particles.x, scene.springs);
   const double kinetic = cl::kinetic_energy(particles);
@@ -108,12 +104,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
-  std::printf("  time %.3e s: %.3e s per frame", result.seconds,
-              result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
-  if (projections > 0) std::printf(", %.3e s per spring projection", result.seconds / projections);
+  cl::print_time(result.seconds, result.frames_done, "frame", projections, "spring projection");
   std::printf("\n");
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
@@ -158,30 +151,16 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
 
-  std::vector<int> ks = lab.sweep_iterations;
+  const std::vector<int>& ks = lab.sweep_iterations;
   std::vector<cl::lab08::RunResult> results(ks.size());
-  std::vector<std::size_t> by_cost(ks.size());
-  for (std::size_t r = 0; r < ks.size(); ++r) by_cost[r] = r;
-  std::stable_sort(by_cost.begin(), by_cost.end(), [&](std::size_t a, std::size_t b) { return ks[a] > ks[b]; });
-
-  std::exception_ptr failure;
-  const auto count = static_cast<long>(ks.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long k = 0; k < count; ++k) {
-    const std::size_t r = by_cost[static_cast<std::size_t>(k)];
-    try {
-      cl::Particles particles = scene.particles;
-      cl::lab08::RunPlan plan;
-      plan.frames = scene.steps;
-      plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
-      plan.settle_tolerance = lab.settle_tolerance;
-      results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
-    } catch (...) {
-#pragma omp critical(lab08_sweep_failure)
-      if (!failure) failure = std::current_exception();
-    }
-  }
-  if (failure) std::rethrow_exception(failure);
+  cl::run_shared(cl::costliest_first(std::vector<double>(ks.begin(), ks.end())), [&](std::size_t r) {
+    cl::Particles particles = scene.particles;
+    cl::lab08::RunPlan plan;
+    plan.frames = scene.steps;
+    plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
+    plan.settle_tolerance = lab.settle_tolerance;
+    results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
+  });
 
   cl::CsvTable table({"scene", "method", "dt", "substeps", "iterations", "frames_run", "time_run", "window_seconds",
                       "steady_total_stretch", "material_total_stretch", "stiffness_ratio", "steady_max_strain",

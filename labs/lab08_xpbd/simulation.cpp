@@ -6,8 +6,6 @@
 #include <stdexcept>
 #include <string>
 
-#include "common/timer.h"
-#include "common/window_means.h"
 
 namespace cl::lab08 {
 
@@ -102,58 +100,49 @@ double mechanical(const FrameRecord& record) { return record.kinetic + record.po
 }  // namespace
 
 RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constraints, const FrameSettings& frame,
-                     const RunPlan& plan, const FrameCallback& on_frame) {
+                     const RunPlan& plan, const FrameCallback& on_frame, const FrameOutput& output) {
   if (plan.frames < 0 || plan.window_frames < 1 || !(plan.settle_tolerance >= 0.0)) {
     throw std::invalid_argument("run_frames: needs frames >= 0, window_frames >= 1, settle_tolerance >= 0");
   }
   RunResult result;
-  FrameRecord record = measure(0, 0.0, particles, constraints, frame, 0.0);
-  result.energy_start = total(record);
-  result.energy_end = result.energy_start;
-  const double mechanical_start = mechanical(record);
   result.energy_scale = energy_scale(particles, frame.gravity, frame.dt);
-  record.problem = health_problem(particles, record.strain);
-  if (on_frame) on_frame(record, particles);
-  result.problem = record.problem;
-  if (!result.problem.empty()) {
-    result.problem_frame = 0;
-    return result;
-  }
+  FramePlan loop = frame_plan(plan.frames, frame.dt, result.energy_scale);
+  loop.energy_name = "kinetic + potential energy";
+  loop.window_frames = plan.window_frames;
+  loop.settle_tolerance = plan.settle_tolerance;
 
-  WindowMeans stretch(plan.window_frames), max_strain(plan.window_frames);
-  for (int f = 1; f <= plan.frames; ++f) {
-    const Timer timer;
+  FrameRecord record;
+  auto step = [&](int) {
     advance_frame(particles, constraints, frame, result.lambda);
-    const double seconds = timer.seconds();
-    result.seconds += seconds;
+    return StepVerdict{};
+  };
+  auto measured = [&](int f, double seconds) {
     record = measure(f, f * frame.dt, particles, constraints, frame, seconds);
-    result.frames_done = f;
     result.energy_end = total(record);
+    if (f == 0) result.energy_start = result.energy_end;
     result.max_energy_rise = std::max(result.max_energy_rise, result.energy_end - result.energy_start);
-    const double rise = mechanical(record) - mechanical_start;
-    record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty()) {
-      record.problem = energy_rise_problem(rise, result.energy_scale, "kinetic + potential energy");
-    }
-    if (on_frame) on_frame(record, particles);
-    result.problem = record.problem;
-    if (!result.problem.empty()) {
-      result.problem_frame = f;
-      return result;
-    }
-    max_strain.add(record.strain.max);
-    if (!stretch.add(record.total_stretch)) continue;
+    return FrameMeasure{record.strain,
+                        mechanical(record),
+                        {record.total_stretch, record.strain.max},
+                        {record.strain.max, record.strain.rms, record.total_stretch, record.kinetic, record.potential,
+                         record.elastic, total(record), seconds},
+                        {}};
+  };
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, loop, output, record_hook(record, on_frame));
 
-    result.window_total_stretch = stretch.last();
-    result.window_max_strain = max_strain.last();
-    result.windows_done = stretch.windows_done();
-    result.window_spread = stretch.relative_spread();
-    if (stretch.settled(plan.settle_tolerance)) {
-      result.settled = true;
-      break;
-    }
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
+  result.windows_done = run.windows_done;
+  if (run.windows_done > 0) {
+    result.window_total_stretch = run.window_means[0];
+    result.window_max_strain = run.window_means[1];
   }
+  result.window_spread = run.window_spread;
+  result.settled = run.settled;
   return result;
+}
+
+std::vector<std::string> frame_columns() {
+  return {"max_strain", "rms_strain", "total_stretch", "kinetic", "potential", "elastic", "total_energy", "seconds"};
 }
 
 }  // namespace cl::lab08

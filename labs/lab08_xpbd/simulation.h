@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "pbd.h"
@@ -94,13 +95,19 @@ struct RunResult {
 
 using FrameCallback = std::function<void(const FrameRecord&, const Particles&)>;
 
-// Runs frame by frame, measuring after each and calling `on_frame` (if set)
-// for frame 0 and every frame after it. Stops at the first unhealthy frame
-// (health_problem, or a kinetic + gravitational energy that rose more than
-// energy_scale above its start — lab 04's check; the elastic energy is left
-// out because an unconverged XPBD step over-stretches the springs, see
-// simulation.cpp) and says why in RunResult::problem.
+// Runs frame by frame in common/frame_loop.h's loop, measuring after each and
+// calling `on_frame` (if set) for frame 0 and every frame after it. Stops at
+// the first unhealthy frame (health_problem, or a kinetic + gravitational
+// energy that rose more than energy_scale above its start — lab 04's check;
+// the elastic energy is left out because an unconverged XPBD step
+// over-stretches the springs, see simulation.cpp) and says why in
+// RunResult::problem. `output` asks the loop for the per-frame CSV
+// (frame_columns()) and OBJ frames.
 RunResult run_frames(Particles& particles, const lab04::ConstraintSet& constraints, const FrameSettings& frame,
-                     const RunPlan& plan, const FrameCallback& on_frame = nullptr);
+                     const RunPlan& plan, const FrameCallback& on_frame = nullptr, const FrameOutput& output = {});
+
+// The lab's columns of the per-frame CSV: max_strain, rms_strain,
+// total_stretch (m), kinetic, potential, elastic, total_energy (J), seconds.
+std::vector<std::string> frame_columns();
 
 }  // namespace cl::lab08

@@ -18,6 +18,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "common/output.h"
@@ -108,53 +109,38 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const double scale = cl::energy_scale(particles, scene.gravity, scene.dt);
   const auto m = static_cast<Eigen::Index>(scene.springs.size());
 
-  cl::CsvTable table({"frame", "time", "max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda",
-                      "kinetic", "potential", "spring_energy", "total_energy", "step_seconds", "status"});
   Eigen::VectorXd lambda;  // the previous step's multipliers (none before the first step)
-  auto add_row = [&](int frame, double seconds, const std::string& status) {
+  double worst_transverse = cl::lab09::max_transverse_speed(particles, scene.springs);
+  auto step = [&](int) -> cl::StepVerdict {
+    const cl::lab09::StableStepResult result = cl::lab09::stable_step(particles, scene.springs, map, settings, lambda);
+    if (!result.ok) return {"failed: " + result.problem, false};
+    lambda = result.lambda;
+    worst_transverse = std::max(worst_transverse, cl::lab09::max_transverse_speed(particles, scene.springs));
+    return {};
+  };
+  auto measure = [&](int, double seconds) {
     const double kinetic = cl::kinetic_energy(particles);
     const double potential = cl::potential_energy(particles, scene.gravity);
     const double elastic = cl::lab09::spring_energy(particles.x, scene.springs);
     const bool known = lambda.size() == m && m > 0;
-    table.add_row({static_cast<long long>(frame), frame * scene.dt,
-                   cl::lab07::max_constraint_error(particles.x, scene.springs),
-                   cl::lab09::max_transverse_speed(particles, scene.springs),
-                   known ? cl::CsvCell{lambda.minCoeff()} : cl::CsvCell{std::string()},
-                   known ? cl::CsvCell{lambda.maxCoeff()} : cl::CsvCell{std::string()}, kinetic, potential, elastic,
-                   kinetic + potential + elastic, seconds, status});
+    return cl::FrameMeasure{cl::strain_stats(particles.x, scene.springs), kinetic + potential + elastic, {},
+                            {cl::lab07::max_constraint_error(particles.x, scene.springs),
+                             cl::lab09::max_transverse_speed(particles, scene.springs),
+                             known ? cl::CsvCell{lambda.minCoeff()} : cl::CsvCell{std::string()},
+                             known ? cl::CsvCell{lambda.maxCoeff()} : cl::CsvCell{std::string()}, kinetic, potential,
+                             elastic, kinetic + potential + elastic, seconds},
+                            {}};
   };
-
-  std::string outcome;  // "diverged: …" or "failed: …"
-  int problem_frame = -1;
-  std::string problem = check_health(particles, scene, energy_start, scale);
-  add_row(0, 0.0, problem.empty() ? "ok" : "diverged: " + problem);
-  if (!problem.empty()) {
-    outcome = "diverged: " + problem;
-    problem_frame = 0;
-  }
-  double seconds = 0.0, worst_transverse = cl::lab09::max_transverse_speed(particles, scene.springs);
-  int frames_done = 0;
-  for (int f = 1; f <= scene.steps && outcome.empty(); ++f) {
-    const cl::Timer timer;
-    const cl::lab09::StableStepResult result = cl::lab09::stable_step(particles, scene.springs, map, settings, lambda);
-    const double step_seconds = timer.seconds();
-    seconds += step_seconds;
-    if (!result.ok) {
-      outcome = "failed: " + result.problem;
-      problem_frame = f;
-      add_row(f, step_seconds, outcome);
-      break;
-    }
-    lambda = result.lambda;
-    frames_done = f;
-    worst_transverse = std::max(worst_transverse, cl::lab09::max_transverse_speed(particles, scene.springs));
-    problem = check_health(particles, scene, energy_start, scale);
-    add_row(f, step_seconds, problem.empty() ? "ok" : "diverged: " + problem);
-    if (!problem.empty()) {
-      outcome = "diverged: " + problem;
-      problem_frame = f;
-    }
-  }
+  const cl::FramePlan plan = cl::frame_plan(scene.steps, scene.dt, scale);
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = {"max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda", "kinetic",
+                    "potential", "spring_energy", "total_energy", "step_seconds"};
+  const cl::FrameLoopResult run = cl::run_frame_loop(particles, step, measure, plan, output);
+  const int frames_done = run.frames_done;
+  const int problem_frame = run.problem_frame;
+  const double seconds = run.seconds;
+  const std::string outcome = run.problem.empty() ? std::string() : run.status;  // "diverged: …" or "failed: …"
 
   const bool stopped = !outcome.empty();
   const bool finite = cl::all_finite(particles.x) && cl::all_finite(particles.v);
@@ -182,7 +168,6 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  multipliers from %.6g N to %.6g N (negative: tension)\n", lambda.minCoeff(), lambda.maxCoeff());
   }
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, seconds);
     summary.extra["geometric_stiffness"] = lab.geometric_stiffness;

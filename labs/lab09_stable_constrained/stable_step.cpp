@@ -19,18 +19,6 @@ lab07::StepSolution solve(const lab07::LinearizedStep& step, const SparseMatrix&
   return solve_stiff_schur(step, stiffness);
 }
 
-// ok, or why not: a failed solve, or one whose sizes or values are wrong.
-std::string check_solution(const lab07::StepSolution& solution, const lab07::LinearizedStep& step) {
-  if (!solution.ok) return solution.problem.empty() ? "the solve failed without saying why" : solution.problem;
-  if (solution.velocity.size() != step.velocity.size() || solution.lambda.size() != step.phi.size()) {
-    return "the solve returned v_new or lambda of the wrong size";
-  }
-  if (!solution.velocity.allFinite() || !solution.lambda.allFinite()) {
-    return "the solve returned a non-finite v_new or lambda";
-  }
-  return {};
-}
-
 }  // namespace
 
 StableStepResult stable_step(Particles& particles, const std::vector<Spring>& springs, const MovableMap& map,
@@ -43,7 +31,7 @@ StableStepResult stable_step(Particles& particles, const std::vector<Spring>& sp
     Eigen::VectorXd lambda_bar = previous_lambda;
     if (lambda_bar.size() != static_cast<Eigen::Index>(springs.size())) {
       const lab07::StepSolution first = solve(step, stiffness, settings.step.method);
-      result.problem = check_solution(first, step);
+      result.problem = lab07::solution_problem(first, size, step.phi.size());
       if (!result.problem.empty()) return result;
       lambda_bar = first.lambda;
       result.first_solve = true;
@@ -51,7 +39,7 @@ StableStepResult stable_step(Particles& particles, const std::vector<Spring>& sp
     stiffness = geometric_stiffness(particles.x, springs, lambda_bar, map, settings.compression);
   }
   lab07::StepSolution solution = solve(step, stiffness, settings.step.method);
-  result.problem = check_solution(solution, step);
+  result.problem = lab07::solution_problem(solution, size, step.phi.size());
   if (!result.problem.empty()) return result;
   lab07::update_positions(particles, map, solution.velocity, settings.step.dt);
   result.ok = true;

@@ -18,7 +18,6 @@
 #include "common/csv.h"
 #include "common/hierarchy.h"
 #include "common/metrics.h"
-#include "common/obj.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "hpbd.h"
@@ -91,22 +90,17 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const std::string frames_dir = cl::join_path(options.out, "frames");
   if (lab.frames_every > 0) cl::ensure_directory(frames_dir);
 
-  cl::CsvTable table({"frame", "time", "max_strain", "rms_strain", "kinetic", "potential", "total_energy",
-                      "seconds", "status"});
-  int frames_written = 0;
-  const cl::lab10::FrameCallback on_frame = [&](const cl::lab10::FrameRecord& record, const cl::Particles& state) {
-    table.add_row({static_cast<long long>(record.frame), record.time, record.strain.max, record.strain.rms,
-                   record.kinetic, record.potential, record.kinetic + record.potential, record.seconds,
-                   record.problem.empty() ? std::string("ok") : "diverged: " + record.problem});
-    const bool last = record.frame == scene.steps;
-    if (lab.frames_every > 0 && record.problem.empty() && (record.frame % lab.frames_every == 0 || last)) {
-      cl::write_frame_obj(frames_dir, kLab, scene, state.x, record.frame, record.time);
-      ++frames_written;
-    }
-  };
+  cl::FrameOutput output;
+  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
+  output.columns = cl::lab10::frame_columns();
+  output.obj_every = lab.frames_every;
+  output.obj_dir = frames_dir;
+  output.lab = kLab;
+  output.scene = &scene;
 
   cl::Particles& particles = scene.particles;
-  const cl::lab10::RunResult result = cl::lab10::run_frames(particles, hierarchy, settings, scene.steps, on_frame);
+  const cl::lab10::RunResult result =
+      cl::lab10::run_frames(particles, hierarchy, settings, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const double kinetic = cl::kinetic_energy(particles);
   const double potential = cl::potential_energy(particles, scene.gravity);
@@ -132,9 +126,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               result.frames_done > 0 ? result.seconds / result.frames_done : 0.0);
   if (result.projections > 0) std::printf(", %.3e s per projection", result.seconds / static_cast<double>(result.projections));
   std::printf("\n");
-  if (frames_written > 0) std::printf("  %d OBJ frames in %s\n", frames_written, frames_dir.c_str());
+  if (result.obj_frames > 0) std::printf("  %d OBJ frames in %s\n", result.obj_frames, frames_dir.c_str());
 
-  if (!options.out.empty()) table.write(cl::join_path(options.out, "per_frame.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary =
         cl::stepping_summary(kLab, method_name(lab.levels), scene, particles, strain, result.seconds);

@@ -41,18 +41,6 @@ Eigen::Matrix3Xd predict(const Particles& particles, double dt, const Eigen::Vec
   return predicted;
 }
 
-FrameRecord measure(int frame, double time, const Particles& particles, const ClothHierarchy& hierarchy,
-                    const Eigen::Vector3d& gravity, double seconds) {
-  FrameRecord record;
-  record.frame = frame;
-  record.time = time;
-  record.strain = strain_stats(particles.x, hierarchy.levels.front().springs);
-  record.kinetic = kinetic_energy(particles);
-  record.potential = potential_energy(particles, gravity);
-  record.seconds = seconds;
-  record.problem = health_problem(particles, record.strain);
-  return record;
-}
 
 }  // namespace
 
@@ -68,40 +56,44 @@ void hpbd_step(Particles& particles, const ClothHierarchy& hierarchy, const Hpbd
 }
 
 RunResult run_frames(Particles& particles, const ClothHierarchy& hierarchy, const HpbdSettings& settings,
-                     int frames, const FrameCallback& on_frame) {
+                     int frames, const FrameCallback& on_frame, const FrameOutput& output) {
   if (frames < 0) throw std::invalid_argument("run_frames: frames must be >= 0 (got " + std::to_string(frames) + ")");
   if (hierarchy.levels.empty()) throw std::invalid_argument("run_frames: the hierarchy has no levels");
   RunResult result;
-  const double scale = energy_scale(particles, settings.gravity, settings.dt);
-  FrameRecord record = measure(0, 0.0, particles, hierarchy, settings.gravity, 0.0);
-  result.energy_start = record.kinetic + record.potential;
-  result.energy_end = result.energy_start;
-  if (on_frame) on_frame(record, particles);
-  if (!record.problem.empty()) {
-    result.problem = record.problem;
-    result.problem_frame = 0;
-    return result;
-  }
+  const FramePlan loop = frame_plan(frames, settings.dt, energy_scale(particles, settings.gravity, settings.dt));
+
   const long long per_step = projections_per_pass(hierarchy, settings.iterations);
-  for (int f = 1; f <= frames; ++f) {
-    const Timer timer;
+  FrameRecord record;
+  auto step = [&](int) {
     hpbd_step(particles, hierarchy, settings);
-    const double seconds = timer.seconds();
-    result.seconds += seconds;
     result.projections += per_step;
-    result.frames_done = f;
-    record = measure(f, f * settings.dt, particles, hierarchy, settings.gravity, seconds);
-    result.energy_end = record.kinetic + record.potential;
-    const double rise = result.energy_end - result.energy_start;
-    if (record.problem.empty()) record.problem = energy_rise_problem(rise, scale);
-    if (on_frame) on_frame(record, particles);
-    if (!record.problem.empty()) {
-      result.problem = record.problem;
-      result.problem_frame = f;
-      return result;
-    }
-  }
+    return StepVerdict{};
+  };
+  auto measure = [&](int f, double seconds) {
+    record = FrameRecord{};
+    record.frame = f;
+    record.time = f * settings.dt;
+    record.strain = strain_stats(particles.x, hierarchy.levels.front().springs);
+    record.kinetic = kinetic_energy(particles);
+    record.potential = potential_energy(particles, settings.gravity);
+    record.seconds = seconds;
+    const double total = record.kinetic + record.potential;
+    return FrameMeasure{record.strain,
+                        total,
+                        {},
+                        {record.strain.max, record.strain.rms, record.kinetic, record.potential, total, seconds},
+                        {}};
+  };
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, loop, output, record_hook(record, on_frame));
+  copy_outcome(run, result, result.frames_done, result.problem_frame);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  result.obj_frames = run.obj_frames;
   return result;
+}
+
+std::vector<std::string> frame_columns() {
+  return {"max_strain", "rms_strain", "kinetic", "potential", "total_energy", "seconds"};
 }
 
 ConvergenceResult converge_one_step(const Particles& particles, const ClothHierarchy& hierarchy, double dt,

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/hierarchy.h"
 #include "common/metrics.h"
@@ -50,15 +51,22 @@ struct RunResult {
   long long projections = 0;  // constraint projections of all steps
   std::string problem;        // empty unless the run became unstable (it stops there)
   int problem_frame = -1;
+  int obj_frames = 0;         // OBJ files written (FrameOutput)
 };
 
 using FrameCallback = std::function<void(const FrameRecord&, const Particles&)>;
 
-// `frames` steps of hpbd_step, measured after each and passed to `on_frame`
-// (frame 0 too). Stops at the first unhealthy frame: health_problem
-// (common/health.h), or a total energy more than energy_scale above its start.
+// `frames` steps of hpbd_step in common/frame_loop.h's loop, measured after
+// each and passed to `on_frame` (frame 0 too). Stops at the first unhealthy
+// frame: health_problem (common/health.h), or a total energy more than
+// energy_scale above its start. `output` asks the loop for the per-frame CSV
+// (frame_columns()) and OBJ frames.
 RunResult run_frames(Particles& particles, const ClothHierarchy& hierarchy, const HpbdSettings& settings,
-                     int frames, const FrameCallback& on_frame = nullptr);
+                     int frames, const FrameCallback& on_frame = nullptr, const FrameOutput& output = {});
+
+// The lab's columns of the per-frame CSV: max_strain, rms_strain, kinetic,
+// potential, total_energy (J), seconds.
+std::vector<std::string> frame_columns();
 
 // Experiment 1: how fast one step's projection converges. From `particles`
 // (normally a cloth at rest) predict one step (gravity; pinned particles stay),

@@ -1,0 +1,30 @@
+#include "common/driver.h"
+
+#include <cstdio>
+
+namespace cl {
+
+std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<std::string>& names,
+                               const std::string& lab_scene_dir) {
+  std::vector<Scene> scenes;
+  for (const std::string& name : names.empty() ? std::vector<std::string>{options.scene} : names) {
+    CommonOptions one = options;
+    one.scene = name;
+    scenes.push_back(load_scene_for(one, lab_scene_dir));
+  }
+  return scenes;
+}
+
+std::vector<std::size_t> costliest_first(const std::vector<double>& costs) {
+  std::vector<std::size_t> order(costs.size());
+  for (std::size_t r = 0; r < order.size(); ++r) order[r] = r;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return costs[a] > costs[b]; });
+  return order;
+}
+
+void print_time(double seconds, int steps, const char* step, double work, const char* work_unit) {
+  std::printf("  time %.3e s: %.3e s per %s", seconds, steps > 0 ? seconds / steps : 0.0, step);
+  if (work > 0) std::printf(", %.3e s per %s", seconds / work, work_unit);
+}
+
+}  // namespace cl

@@ -1,0 +1,56 @@
+#pragma once
+// The driver kit: what the labs' main.cpp do alike besides the common flags
+// and run_main (common/cli.h) and the summary's shared fields
+// (common/summary.h) — the scenes of a sweep, its runs shared among threads
+// costliest first, and the run's time line on the terminal.
+#include <algorithm>
+#include <cstddef>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/scene.h"
+
+namespace cl {
+
+// The scenes a sweep runs: each name of `names` (--sweep-scenes) or, when it
+// is empty, --scene alone, loaded as load_scene_for does (--dt and --steps
+// applied). Throws InputError for the first that does not load.
+std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<std::string>& names,
+                               const std::string& lab_scene_dir);
+
+// The indices 0 … n−1 of `costs`, costliest first (ties keep their order).
+std::vector<std::size_t> costliest_first(const std::vector<double>& costs);
+
+// Runs run(order[0]), run(order[1]), … shared among the OpenMP threads (when
+// the caller is compiled with OpenMP; one after the other otherwise), one run
+// at a time per thread, in that order. Every run is done; then the first
+// exception any run threw is thrown again. Runs must not share what they write.
+template <class Run>
+void run_shared(const std::vector<std::size_t>& order, const Run& run) {
+  std::exception_ptr failure;
+  const auto count = static_cast<long>(order.size());
+#ifdef _OPENMP
+#pragma omp parallel for schedule(dynamic, 1)
+#endif
+  for (long k = 0; k < count; ++k) {
+    try {
+      run(order[static_cast<std::size_t>(k)]);
+    } catch (...) {
+#ifdef _OPENMP
+#pragma omp critical(cl_run_shared_failure)
+#endif
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
+// The run's time on the terminal, one line:
+//     "  time <seconds> s: <seconds/steps> s per <step>[, <seconds/work> s per <work_unit>]"
+// (3 significant digits, e notation; the per-step figure is 0 for steps <= 0,
+// the work figure only when work > 0). No line break: a lab may add to it.
+void print_time(double seconds, int steps, const char* step, double work = 0.0, const char* work_unit = "");
+
+}  // namespace cl

@@ -1,0 +1,64 @@
+// common/driver.h: the scenes of a sweep, its runs costliest first and shared
+// among threads (every run done, the first failure thrown again).
+#include <atomic>
+#include <fstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <catch2/catch.hpp>
+
+#include "common/driver.h"
+#include "common/output.h"
+
+namespace {
+
+// A scene file in the working directory; its path.
+std::string scene_file(const std::string& name, int steps) {
+  const std::string path = "driver_kit_" + name + ".json";
+  cl::write_file_atomic(path, R"({"name": ")" + name + R"(", "dt": 0.01, "steps": )" + std::to_string(steps) +
+                                  R"(, "particles": [{"x": [0, 0, 0]}, {"x": [1, 0, 0]}], "springs": [{"i": 0, "j": 1}]})");
+  return path;
+}
+
+}  // namespace
+
+TEST_CASE("load_scenes loads the sweep's scenes in order, or --scene alone, with --steps applied", "[common][driver]") {
+  cl::CommonOptions options;
+  options.scene = scene_file("alone", 5);
+  options.steps = 3;
+  const std::vector<cl::Scene> alone = cl::load_scenes(options, {}, ".");
+  REQUIRE(alone.size() == 1);
+  CHECK(alone[0].name == "alone");
+  CHECK(alone[0].steps == 3);
+
+  const std::vector<cl::Scene> both = cl::load_scenes(options, {scene_file("first", 5), scene_file("second", 6)}, ".");
+  REQUIRE(both.size() == 2);
+  CHECK(both[0].name == "first");
+  CHECK(both[1].name == "second");
+  CHECK(both[1].steps == 3);
+
+  CHECK_THROWS_AS(cl::load_scenes(options, {"driver_kit_no_such_scene.json"}, "."), cl::InputError);
+}
+
+TEST_CASE("costliest_first orders by cost, ties in their order", "[common][driver]") {
+  CHECK(cl::costliest_first({}).empty());
+  CHECK(cl::costliest_first({1.0, 3.0, 2.0, 3.0}) == std::vector<std::size_t>{1, 3, 2, 0});
+}
+
+TEST_CASE("run_shared runs every index once and throws the first failure after all ran", "[common][driver]") {
+  std::vector<int> ran(50, 0);
+  std::vector<std::size_t> order;
+  for (std::size_t r = 0; r < ran.size(); ++r) order.push_back(ran.size() - 1 - r);
+  cl::run_shared(order, [&](std::size_t r) { ++ran[r]; });
+  CHECK(ran == std::vector<int>(50, 1));
+
+  std::atomic<int> done{0};
+  CHECK_THROWS_WITH(cl::run_shared(order,
+                                   [&](std::size_t r) {
+                                     ++done;
+                                     if (r == 7) throw std::runtime_error("run 7 failed");
+                                   }),
+                    "run 7 failed");
+  CHECK(done == 50);
+}
