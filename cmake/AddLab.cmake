@@ -232,6 +232,12 @@ function(add_lab name)
     target_link_libraries(${name}_tests_solution PRIVATE catch_main ${reference_chain} common)
     set_target_properties(${name}_tests_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
+    # Ungraded tests of the lab's given code ([labNN_given], on the reference):
+    # part of the unit tests (ctest -L unit), never of a score.
+    string(SUBSTRING "${name}" 0 5 lab_tag)
+    add_test(NAME ${name}_given COMMAND ${name}_tests_solution "[${lab_tag}_given]")
+    set_tests_properties(${name}_given PROPERTIES LABELS unit)
+
     if(info_sources)
       add_executable(${name}_info_solution $<TARGET_OBJECTS:${name}_info_objects>)
       target_link_libraries(${name}_info_solution PRIVATE ${reference_chain} common)

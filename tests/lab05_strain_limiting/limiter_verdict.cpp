@@ -8,7 +8,8 @@
 //
 // Not graded ([lab05_given], no [lab05] tag): the run uses the student's
 // limit_spring, so it fails on the stubs, and it charges nothing to a task.
-// `./course grade` does not run it; run it with
+// `./course grade` does not run it; `./course test` does, as the unit test
+// lab05_strain_limiting_given (ctest -L unit, cmake/AddLab.cmake), or run
 //     build/bin/lab05_strain_limiting_tests_solution "[lab05_given]"
 #include <cmath>
 #include <string>
