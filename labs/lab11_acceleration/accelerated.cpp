@@ -539,7 +539,7 @@ double total_energy(const Particles& particles, const std::vector<Spring>& sprin
 }  // namespace
 
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step) {
+                    const StepCallback& on_step, const RunIterationCallback& on_iteration) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
   const std::vector<Spring>& springs = solver.springs();
   const bool elastic = minimises_objective(method);
@@ -560,7 +560,14 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
   for (int s = 1; s <= steps; ++s) {
     record = StepRecord{};
     record.step = s;
-    record.report = solver.step(particles, method, settings);
+    IterationCallback each = nullptr;
+    if (on_iteration) {
+      each = [&](const IterationRecord& iteration) {
+        on_iteration(s, iteration);
+        return false;
+      };
+    }
+    record.report = solver.step(particles, method, settings, each);
     result.seconds += record.report.seconds;
     result.iterations_done += record.report.iterations_done;
     result.restarts += record.report.restarts;

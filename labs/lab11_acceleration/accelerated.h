@@ -132,6 +132,8 @@ struct StepRecord {
   std::string problem;    // empty when healthy
 };
 using StepCallback = std::function<void(const StepRecord&, const Particles&)>;
+// Every iteration of step `step` (1, 2, …), for a per-iteration record.
+using RunIterationCallback = std::function<void(int step, const IterationRecord&)>;
 
 struct RunResult {
   int steps_done = 0;
@@ -148,6 +150,6 @@ struct RunResult {
 // (common/health.h), or one whose total energy rose more than the scene's
 // energy scale above its start.
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step = nullptr);
+                    const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr);
 
 }  // namespace cl::lab11
