@@ -44,9 +44,11 @@ cl::Scene load(const cl::CommonOptions& options, const std::string& name, Method
   return scene;
 }
 
-// --rho, or ρ measured on the scene's first step (Wang: once per scene).
+// --rho, or ρ measured on the scene's first step (Wang: once per scene); 0 for
+// the methods without Chebyshev.
 double rho_for(cl::lab11::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
   if (!lab.estimate) return lab.settings.rho;
+  if (method != Method::kPdChebyshev && method != Method::kJacobiChebyshev) return 0.0;
   cl::lab11::Settings settings = lab.settings;
   settings.gravity = scene.gravity;
   const double rho = solver.estimate_rho(scene.particles, method, settings, lab.estimate_iterations);
@@ -73,10 +75,11 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const cl::lab11::RunResult result = cl::lab11::run_steps(particles, solver, method, settings, scene.steps, nullptr,
                                                            options.out.empty() ? nullptr : on_iteration);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+  const bool chebyshev = method == Method::kPdChebyshev || method == Method::kJacobiChebyshev;
   std::printf("%s: scene %s, %s, K = %d, rho %.6f%s, gamma %g, delay %d, history %d, %d steps of %.4g s\n", kLab,
               scene.name.c_str(), options.method.c_str(), options.iterations, settings.rho,
-              lab.estimate ? " (estimated)" : "", settings.gamma, settings.delay, settings.history, scene.steps,
-              scene.dt);
+              !chebyshev ? " (not used)" : lab.estimate ? " (estimated)" : "", settings.gamma, settings.delay,
+              settings.history, scene.steps, scene.dt);
   if (!result.problem.empty()) std::printf("  DIVERGED at step %d: %s\n", result.problem_step, result.problem.c_str());
   std::printf("  max strain %.3e, rms %.3e; %lld iterations, %d restarts, %d failed line searches; %.3e s (%.3e s "
               "per step)\n", strain.max, strain.rms, result.iterations_done, result.restarts,
