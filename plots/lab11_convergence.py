@@ -30,7 +30,7 @@ def label(row):
     if method == "pd-lbfgs":
         return f"L-BFGS, m = {row['history']}"
     if method in ("pd-chebyshev", "jacobi-chebyshev"):
-        return f"{method}, rho = {float(row['rho']):.5g}"
+        return f"{method}, rho = {float(row['rho']):.7g}"
     return method
 
 
