@@ -87,7 +87,7 @@ class Solver {
   // one step from `start` (which is not changed): the update lengths of up to
   // `iterations` plain iterations (ending early where they reach round-off),
   // given to estimate_spectral_radius.
-  double estimate_rho(const Particles& start, Method method, const Settings& settings, int iterations = 60);
+  double estimate_rho(const Particles& start, Method method, const Settings& settings, int iterations = 400);
 
   const lab06::Problem& problem();  // makes the PD pieces if needed
   double dt() const { return dt_; }
