@@ -31,7 +31,9 @@
 #   NAME_solution, NAME_tests_solution, NAME_info_solution   the same, reference throughout
 #
 # Drivers see CL_LAB_NAME (the lab, for summaries), CL_PROGRAM_NAME (the
-# executable, for messages) and CL_LAB_SCENE_DIR (absolute path of scenes/).
+# executable, for messages) and CL_LAB_SCENE_DIR (absolute path of scenes/, an
+# expression: no absolute path is on a command line but common's own, so
+# ccache serves a copy of the tree from the first tree's compiles).
 #
 # The build writes ${PROJECT_BINARY_DIR}/labs.json, read by tools/course.py: per
 # lab its student files, whether it has a reference, its earlier labs and
@@ -43,6 +45,7 @@ set(CL_SANITIZE_FLAGS -fsanitize=address,undefined -g -O1 -fno-omit-frame-pointe
 function(add_lab name)
   cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS;LIBRARIES" ${ARGN})
   set(lab_dir "${PROJECT_SOURCE_DIR}/labs/${name}")
+
   set(solution_dir "${PROJECT_SOURCE_DIR}/solutions/${name}")
 
   # Earlier labs this one needs, transitively, newest first (static link order).
@@ -54,6 +57,26 @@ function(add_lab name)
   list(REMOVE_DUPLICATES closure)
   list(SORT closure ORDER DESCENDING)
   set_property(GLOBAL PROPERTY CL_LAB_CLOSURE_${name} ${closure})
+
+  # OpenMP flags reach a target through the support libraries it links: this
+  # lab's own (pch_openmp) or, for the driver and the tests, any earlier lab's
+  # too (closure_openmp). The precompiled header must match (cl_use_pch).
+  set(pch_openmp "")
+  if("OpenMP::OpenMP_CXX" IN_LIST LAB_LIBRARIES)
+    set(pch_openmp OPENMP)
+  endif()
+  set(closure_openmp ${pch_openmp})
+  foreach(dep IN LISTS closure)
+    get_property(dep_openmp GLOBAL PROPERTY CL_LAB_OPENMP_${dep})
+    if(dep_openmp)
+      set(closure_openmp OPENMP)
+    endif()
+  endforeach()
+  set_property(GLOBAL PROPERTY CL_LAB_OPENMP_${name} "${pch_openmp}")
+  set(closure_support ${name}_support)
+  foreach(dep IN LISTS closure)
+    list(APPEND closure_support ${dep}_support)
+  endforeach()
 
   # A reference exists when all of the student files are in solutions/NAME; some
   # but not all is a broken tree, not a release.
@@ -92,6 +115,7 @@ function(add_lab name)
     list(TRANSFORM LAB_SUPPORT PREPEND "${lab_dir}/")
     add_library(${name}_support STATIC ${LAB_SUPPORT})
     target_link_libraries(${name}_support PUBLIC common ${LAB_LIBRARIES})
+    cl_use_pch(${name}_support ${pch_openmp})
     target_include_directories(${name}_support PUBLIC "${lab_dir}")
   else()
     add_library(${name}_support INTERFACE)
@@ -143,20 +167,32 @@ function(add_lab name)
   endforeach()
 
   set(bin_dir "${PROJECT_BINARY_DIR}/bin")
-  set(scene_definition CL_LAB_SCENE_DIR="${lab_dir}/scenes")
+  set(scene_definition "CL_LAB_SCENE_DIR=cl::lab_scene_dir(\"${name}\")")
 
-  add_executable(${name} "${lab_dir}/main.cpp")
-  target_link_libraries(${name} PRIVATE ${isolated_chain} common)
+  # main.cpp is compiled once, for NAME and NAME_solution alike: what differs
+  # (the program's name, the earlier labs it runs as the student's code) is a
+  # two-line source generated per executable (cl_program_name, common/cli.h).
+  add_library(${name}_driver OBJECT "${lab_dir}/main.cpp")
+  target_link_libraries(${name}_driver PRIVATE ${closure_support})
+  cl_use_pch(${name}_driver ${closure_openmp})
+  target_compile_definitions(${name}_driver PRIVATE ${scene_definition} CL_LAB_NAME="${name}"
+                             CL_PROGRAM_NAME=cl_program_name CL_STUDENT_EARLIER_LABS=cl_student_earlier_labs)
   list(SORT student_earlier)
   list(JOIN student_earlier " " student_earlier)
-  target_compile_definitions(${name} PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}"
-                             CL_STUDENT_EARLIER_LABS="${student_earlier}")
+  _cl_identity_source(${name} "${student_earlier}" identity)
+  add_executable(${name} "${identity}")
+  target_link_libraries(${name} PRIVATE ${name}_driver ${isolated_chain} common)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
+  # The graded tests are compiled once and linked twice: against the student's
+  # chain (NAME_tests) and the reference's (NAME_tests_solution).
   file(GLOB test_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/*.cpp")
-  add_executable(${name}_tests ${test_sources})
+  add_library(${name}_test_objects OBJECT ${test_sources})
+  target_link_libraries(${name}_test_objects PRIVATE Catch2::Catch2 ${closure_support})
+  target_compile_definitions(${name}_test_objects PRIVATE ${scene_definition})
+  cl_use_pch(${name}_test_objects TESTS ${closure_openmp})
+  add_executable(${name}_tests $<TARGET_OBJECTS:${name}_test_objects>)
   target_link_libraries(${name}_tests PRIVATE catch_main ${isolated_chain} common)
-  target_compile_definitions(${name}_tests PRIVATE ${scene_definition})
   set_target_properties(${name}_tests PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
   # The grader's crash rerun (not built by default): the graded tests and this
@@ -177,27 +213,28 @@ function(add_lab name)
 
   file(GLOB info_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/info/*.cpp")
   if(info_sources)
-    add_executable(${name}_info ${info_sources})
+    add_library(${name}_info_objects OBJECT ${info_sources})
+    target_link_libraries(${name}_info_objects PRIVATE ${closure_support})
+    target_compile_definitions(${name}_info_objects PRIVATE ${scene_definition})
+    cl_use_pch(${name}_info_objects TESTS ${closure_openmp})
+    add_executable(${name}_info $<TARGET_OBJECTS:${name}_info_objects>)
     target_link_libraries(${name}_info PRIVATE ${isolated_chain} common)
-    target_compile_definitions(${name}_info PRIVATE ${scene_definition})
     set_target_properties(${name}_info PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
   endif()
 
   if(has_reference)
-    add_executable(${name}_solution "${lab_dir}/main.cpp")
-    target_link_libraries(${name}_solution PRIVATE ${reference_chain} common)
-    target_compile_definitions(${name}_solution PRIVATE ${scene_definition} CL_LAB_NAME="${name}" CL_PROGRAM_NAME="${name}_solution")
+    _cl_identity_source(${name}_solution "" identity)
+    add_executable(${name}_solution "${identity}")
+    target_link_libraries(${name}_solution PRIVATE ${name}_driver ${reference_chain} common)
     set_target_properties(${name}_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
-    add_executable(${name}_tests_solution ${test_sources})
+    add_executable(${name}_tests_solution $<TARGET_OBJECTS:${name}_test_objects>)
     target_link_libraries(${name}_tests_solution PRIVATE catch_main ${reference_chain} common)
-    target_compile_definitions(${name}_tests_solution PRIVATE ${scene_definition})
     set_target_properties(${name}_tests_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
     if(info_sources)
-      add_executable(${name}_info_solution ${info_sources})
+      add_executable(${name}_info_solution $<TARGET_OBJECTS:${name}_info_objects>)
       target_link_libraries(${name}_info_solution PRIVATE ${reference_chain} common)
-      target_compile_definitions(${name}_info_solution PRIVATE ${scene_definition})
       set_target_properties(${name}_info_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
     endif()
   endif()
@@ -226,6 +263,18 @@ function(add_lab name)
   list(JOIN links_json ", " links_json)
   set_property(GLOBAL APPEND PROPERTY CL_LAB_MANIFEST
     "    \"${name}\": {\"student\": [${student_json}], \"reference\": ${reference_json}, \"info\": ${info_json},\n      \"deps\": [${deps_json}], \"links\": {${links_json}}}")
+endfunction()
+
+# Writes the two-line source that names executable `program` (cl_program_name,
+# cl_student_earlier_labs in common/cli.h); sets `out` to its path.
+function(_cl_identity_source program student_earlier out)
+  set(path "${PROJECT_BINARY_DIR}/identity/${program}.cpp")
+  string(CONFIGURE [=[// Generated by cmake/AddLab.cmake: who this executable is.
+extern "C" const char cl_program_name[] = "@program@";
+extern "C" const char cl_student_earlier_labs[] = "@student_earlier@";
+]=] text @ONLY)
+  file(CONFIGURE OUTPUT "${path}" CONTENT "${text}" @ONLY)
+  set(${out} "${path}" PARENT_SCOPE)
 endfunction()
 
 # Called once the whole CMakeLists.txt is read (cmake_language DEFER): labs.json.

@@ -10,6 +10,18 @@
 
 #include "common/scene.h"
 
+// A lab's main.cpp is compiled once for both of its executables (NAME and
+// NAME_solution); each executable links a generated source (cmake/AddLab.cmake)
+// that defines who it is: its name, and the earlier labs whose reference is not
+// in solutions/ yet, so that it runs the student's own code for them
+// (space-separated, docs/DESIGN.md §4). A driver sees them as CL_PROGRAM_NAME
+// and CL_STUDENT_EARLIER_LABS; elsewhere the latter is empty.
+extern "C" const char cl_program_name[];
+extern "C" const char cl_student_earlier_labs[];
+#ifndef CL_STUDENT_EARLIER_LABS
+#define CL_STUDENT_EARLIER_LABS ""
+#endif
+
 namespace cl {
 
 // Which of the shared flags a lab takes; a lab only offers what it uses.
@@ -49,12 +61,6 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 // lab_scene_dir, and applies --dt and --steps. Throws InputError.
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir);
 
-// The earlier labs whose reference is not in solutions/ yet, so that a lab
-// executable links the student's own code for them (space-separated; set per
-// executable by cmake/AddLab.cmake, docs/DESIGN.md §4; empty elsewhere).
-#ifndef CL_STUDENT_EARLIER_LABS
-#define CL_STUDENT_EARLIER_LABS ""
-#endif
 
 // Parses the command line and runs `body`, mapping every failure to a single
 // stderr line and exit code: CLI and InputError -> 2, NotImplemented -> 3,

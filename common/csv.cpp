@@ -9,7 +9,7 @@ namespace cl {
 namespace {
 // RFC 4180: text with a comma, a quote or a line break goes in quotes, its
 // quotes doubled; any other text is written as it is.
-std::string quoted(const std::string& text) {
+std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
   std::string result = "\"";
   for (const char c : text) result += c == '"' ? std::string("\"\"") : std::string(1, c);
@@ -18,7 +18,7 @@ std::string quoted(const std::string& text) {
 }  // namespace
 
 CsvTable::CsvTable(std::vector<std::string> columns) : columns_(columns.size()) {
-  for (std::size_t c = 0; c < columns.size(); ++c) text_ += (c ? "," : "") + quoted(columns[c]);
+  for (std::size_t c = 0; c < columns.size(); ++c) text_ += (c ? "," : "") + csv_field(columns[c]);
   text_ += '\n';
 }
 
@@ -34,7 +34,7 @@ void CsvTable::add_row(const std::vector<CsvCell>& cells) {
     } else if (const long long* integer = std::get_if<long long>(&cells[c])) {
       text_ += std::to_string(*integer);
     } else {
-      text_ += quoted(std::get<std::string>(cells[c]));
+      text_ += csv_field(std::get<std::string>(cells[c]));
     }
   }
   text_ += '\n';

@@ -586,6 +586,10 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
   throw InputError("--scene: no scene named '" + name_or_path + "' (this lab ships: " + known + ")");
 }
 
+std::string lab_scene_dir(const std::string& lab) {
+  return (fs::path(CL_SOURCE_DIR) / "labs" / lab / "scenes").string();
+}
+
 std::vector<std::string> list_scene_names(const std::string& scene_dir) {
   std::vector<std::string> names;
   std::error_code error;

@@ -47,6 +47,12 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
 // Every scene name shipped in a scenes directory, sorted.
 std::vector<std::string> list_scene_names(const std::string& scene_dir);
 
+// labs/LAB/scenes in this course tree, as an absolute path. Drivers and tests
+// see it as CL_LAB_SCENE_DIR (cmake/AddLab.cmake); a function rather than a
+// path on the command line, so that two copies of the tree (a release, the
+// autograder's) compile the same command lines and share ccache's results.
+std::string lab_scene_dir(const std::string& lab);
+
 // One line for a driver's header: "name (N particles, M springs)", with
 // ", K triangles" before the ")" when the scene has triangles. A scene without
 // springs says "0 springs"; an empty name leaves the text to start with " (".

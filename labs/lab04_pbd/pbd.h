@@ -50,7 +50,7 @@ ConstraintSet make_constraint_set(Eigen::Index particle_count, std::vector<Sprin
 //
 // Shapes: particles.x and .v are 3 × n, updated in place; inv_mass has n
 // entries. Throws std::invalid_argument, before changing anything, for dt that
-// is not finite and > 0, iterations < 0, or v / inv_mass not sized for n
+// is not finite or ≤ 0, iterations < 0, or v / inv_mass not sized for n
 // particles; the sweeps throw for invalid springs or ω as labs 02 and 03 say.
 void pbd_step(Particles& particles, const ConstraintSet& constraints, const PbdSettings& settings);
 

@@ -59,7 +59,7 @@ LimitedSystem make_limited_system(const Scene& scene, Limit limit);
 //   2. K sweeps of settings.limit over the springs (or triangles) in file order,
 //      Gauss-Seidel, each correction applied at once: x̃ → x'.
 //   3. v ← v + (x' − x̃)/Δt; x ← x'.
-// Throws std::invalid_argument for dt not finite and > 0, iterations < 0, or
+// Throws std::invalid_argument for dt not finite or ≤ 0, iterations < 0, or
 // particles not sized alike; the limiters throw for a bad band.
 void limited_step(Particles& particles, const LimitedSystem& system, const StepSettings& settings);
 

@@ -40,7 +40,9 @@ Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen:
 }
 
 // TODO(lab05.3) [4 pts] Limit a triangle's principal stretches to [σ_min, σ_max].
-// Same weights and no-op cases as lab05.2. Build the frame B (triangle_frame),
+// Same weights and no-op cases as lab05.2; also throw std::invalid_argument
+// when rest.shape (D_m) or rest.inverse_shape (D_m⁻¹) is not finite: both are
+// used. Build the frame B (triangle_frame),
 // D_s = Bᵀ [x_j − x_i, x_k − x_i], F = D_s · rest.inverse_shape and its SVD
 // (Eigen::JacobiSVD<Eigen::Matrix2d> with ComputeFullU | ComputeFullV). Clamp
 // both singular values; inside the band return zeros. Otherwise

@@ -64,8 +64,8 @@ TriangleRest make_triangle_rest(const Eigen::Matrix3d& corners);
 //     to push them apart along is defined).
 // A pinned end (w = 0) never moves; the other takes the whole correction.
 // Throws std::invalid_argument for a negative or non-finite inverse mass, a
-// rest length that is not finite and > 0 (σ is undefined for L = 0), a
-// sigma_min that is not finite and > 0, a non-finite sigma_max, or
+// rest length that is not finite or ≤ 0 (σ is undefined for L = 0), a
+// sigma_min that is not finite or ≤ 0, a non-finite sigma_max, or
 // sigma_min > sigma_max.
 lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double inv_mass_i,
                                        double inv_mass_j, double rest_length, double sigma_min, double sigma_max);
@@ -75,8 +75,13 @@ lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::
 // w_i w_j w_k so that nothing is divided by an inverse mass:
 //     c = Σ_a ω_a x_a / Σ_a ω_a,   ω_i = w_j w_k,  ω_j = w_i w_k,  ω_k = w_i w_j.
 // One pinned corner (w = 0) makes c that corner, so it stays put. Two or three
-// pinned corners make every ω zero: no similar triangle (nor any F) can be
-// reached without moving a pinned corner, so both limiters are then a no-op.
+// pinned corners make every ω zero and c undefined. Both limiters are then a
+// no-op, by this lab's convention: the area limiter scales about c, and no
+// scaled copy of a triangle keeps two of its corners in place, so it has no
+// move at all; the stretch limiter could still reach a limited F by moving
+// the one free corner, but only by giving that corner the whole correction, a
+// different rule from the centroid's that would pull a cloth's edge along its
+// pins. A triangle with two pinned corners is left to its springs.
 
 // TODO(lab05.2) — limit a triangle's area ratio A / A_rest to the band
 // [sigma_min², sigma_max²] by scaling it about its mass-weighted centroid c.
@@ -91,7 +96,7 @@ lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::
 // No-op (all zeros): two or three pinned corners (see above), or a triangle of
 // zero area up to round-off (triangle_frame's test: scaling cannot give it an
 // area). Throws std::invalid_argument for a negative or non-finite inverse
-// mass, a rest_area that is not finite and > 0, or sigma_min / sigma_max as
+// mass, a rest_area that is not finite or ≤ 0, or sigma_min / sigma_max as
 // limit_spring says.
 Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen::Vector3d& inv_mass,
                                     double rest_area, double sigma_min, double sigma_max);
@@ -116,9 +121,13 @@ Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen:
 // result keeps its normal); if its edge lengths are the rest ones nothing moves.
 // Zero-area triangles (triangle_frame returns false: collinear or coincident
 // corners) have no frame and no direction to open them in: a no-op (all zeros).
-// Also a no-op: two or three pinned corners. Throws std::invalid_argument for a
-// negative or non-finite inverse mass, a rest whose area is not finite and > 0
-// or whose D_m⁻¹ is not finite, or sigma_min / sigma_max as limit_spring says.
+// Also a no-op: two or three pinned corners (the convention above).
+// Both parts of the rest shape are used: D_m⁻¹ (rest.inverse_shape) to form F,
+// D_m (rest.shape) for the rest corners X_a. Throws std::invalid_argument for a
+// negative or non-finite inverse mass, a rest whose area is not finite or ≤ 0
+// or whose D_m or D_m⁻¹ is not finite, or sigma_min / sigma_max as
+// limit_spring says. (That the two are inverses of each other is triangle_rest's
+// promise; the limiter does not check it.)
 Eigen::Matrix3d limit_triangle_stretch(const Eigen::Matrix3d& corners, const Eigen::Vector3d& inv_mass,
                                        const TriangleRest& rest, double sigma_min, double sigma_max);
 

@@ -15,8 +15,9 @@ namespace cl::lab06 {
 // TODO(lab06.1) [2 pts] The local step.
 // For each spring e = (i, j) with rest length L_e, the point of the sphere of
 // radius L_e nearest to x_i − x_j:  d_e = L_e (x_i − x_j) / ‖x_i − x_j‖.
-// If ‖x_i − x_j‖ is 0 return d_e = L_e (1, 0, 0) (every direction is equally
-// near; this one is documented). Throw std::invalid_argument for an index
+// If the computed ‖x_i − x_j‖ (.norm()) is 0 — equal ends, or ends closer
+// than about 1e-162 m, whose squared length underflows — return
+// d_e = L_e (1, 0, 0) (every direction is equally near; this one is documented). Throw std::invalid_argument for an index
 // outside the columns of x. Returns 3 × m, column e for springs[e].
 // Graded by tests/lab06_projective_dynamics/test_local_step.cpp (2 pts).
 Eigen::Matrix3Xd local_step(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs) {
@@ -38,9 +39,12 @@ SparseMatrix system_matrix(const Problem& problem) {
 }
 
 // TODO(lab06.3) [with lab06.4: 2 pts] The right-hand side b (n_u × 3).
-// Row u starts at m/Δt² · y_p; then each spring (i, j) adds k·d_e to its i end
-// and −k·d_e to its j end when they are unknowns, and a pinned end's held
-// position k·y (of the pinned particle) to the movable end (see the header).
+// Row u starts at m/Δt² · y_p. Then each spring (i, j) adds +k·d_e to the row
+// of i if i is movable and −k·d_e to the row of j if j is movable — whether or
+// not the other end is pinned — and, for a pinned end, its held position k·y
+// (the pinned particle's column of y) to the movable end's row: in all,
+// b_i += k(y_j + d_e) for a pinned j, b_j += k(y_i − d_e) for a pinned i
+// (see the header).
 // Check the columns of y (n) and d (m); throw std::invalid_argument otherwise.
 // Graded by tests/lab06_projective_dynamics/test_global_step.cpp.
 RowsX3 right_hand_side(const Problem& problem, const Eigen::Matrix3Xd& y, const Eigen::Matrix3Xd& d) {

@@ -37,17 +37,20 @@ struct Problem {
 
 // Given code. Throws std::invalid_argument naming the spring for an index out
 // of range, i == j, a negative or non-finite rest length, or a stiffness that
-// is not finite and > 0 ("inf" is a hard constraint: lab 07), and for dt that
-// is not finite and > 0 or an inverse mass that is negative or not finite.
+// is not finite or ≤ 0 ("inf" is a hard constraint: lab 07), and for dt that
+// is not finite or ≤ 0 or an inverse mass that is negative or not finite.
 Problem make_problem(const Eigen::VectorXd& inv_mass, std::vector<Spring> springs, double dt);
 
 // TODO(lab06.1) — the local step: each spring's projection onto its rest length.
 //
 //     d_e = L_e (x_i − x_j) / ‖x_i − x_j‖
 //
-// the point of the sphere of radius L_e closest to x_i − x_j. When the ends
-// coincide (‖x_i − x_j‖ computes to 0) every point of the sphere is equally
-// close: return d_e = L_e (1, 0, 0). Rest length 0 gives d_e = 0.
+// the point of the sphere of radius L_e closest to x_i − x_j. The ends count
+// as coincident when the computed length (Eigen's norm(), the root of the
+// squared length) is 0 — for ends that are equal, and for ends closer than
+// about 1e-162 m, whose squared length underflows to 0. Every point of the
+// sphere is then equally close: return d_e = L_e (1, 0, 0). Rest length 0 gives
+// d_e = 0. (The given Newton code uses the same rule and direction.)
 //
 // x: 3 × n positions. Returns 3 × m, column e for springs[e]. Never NaN for
 // finite x. Throws std::invalid_argument for a spring index out of range.
@@ -63,8 +66,8 @@ Eigen::Matrix3Xd local_step(const Eigen::Matrix3Xd& x, const std::vector<Spring>
 // with one pinned end adds k_e at its movable end's diagonal only; a spring
 // with both ends pinned adds nothing. Symmetric positive definite.
 // Build it from triplets with cl::assemble (common/sparse.h).
-// Throws std::invalid_argument for dt not finite and > 0, or a stiffness not
-// finite and > 0 (naming the spring).
+// Throws std::invalid_argument for dt not finite or ≤ 0, or a stiffness that
+// is not finite or ≤ 0 (naming the spring).
 SparseMatrix system_matrix(const Problem& problem);
 
 // TODO(lab06.3) — the right-hand side of A x = b for fixed projections d:

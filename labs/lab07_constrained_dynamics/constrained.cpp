@@ -38,8 +38,8 @@ SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Sp
 // M = diag(1/step.inv_mass) (3u entries). C's entries go in only where they are
 // non-zero, and not at all when step.compliance is empty (every spring hard).
 // Throw std::invalid_argument when sizes disagree (jacobian m × 3u, phi m,
-// compliance m or empty, inv_mass and velocity 3u), dt is not finite and > 0,
-// or an inverse mass is not finite and > 0.
+// compliance m or empty, inv_mass and velocity 3u), dt is not finite or ≤ 0,
+// or an inverse mass is not finite or ≤ 0.
 // Graded by tests/lab07_constrained_dynamics/test_kkt.cpp.
 KktSystem kkt_system(const LinearizedStep& step) {
   (void)step;
@@ -55,8 +55,9 @@ KktSystem kkt_system(const LinearizedStep& step) {
 // and a one-line problem (never NaN). Throw std::invalid_argument when the matrix
 // is not square, the rhs has the wrong size, or velocity_unknowns is outside
 // [0, size].
-// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (one 1-D spring
-// in closed form, both methods).
+// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (a 1-D spring in
+// closed form, 1) and test_agreement.cpp (a dense solve on random scenes, 1);
+// both hand you the KKT system the test writes out, not your kkt_system's.
 StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) {
   (void)system, (void)velocity_unknowns;
   not_implemented("solve_kkt", __FILE__);
@@ -69,8 +70,9 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
 // Factor S with cl::SpdFactorization; when factor() refuses, return ok = false
 // with a problem line containing "singular". With no springs (m = 0) return
 // v_new = v + Δt g and an empty λ. Check the step as kkt_system does.
-// Graded by tests/lab07_constrained_dynamics/test_agreement.cpp (KKT and Schur
-// agree on random scenes, 3) and test_redundant.cpp (2).
+// Graded by tests/lab07_constrained_dynamics/test_spring.cpp (a 1-D spring in
+// closed form, 1), test_agreement.cpp (a dense solve of the KKT system on
+// random scenes, 2) and test_redundant.cpp (2).
 StepSolution solve_schur(const LinearizedStep& step) {
   (void)step;
   not_implemented("solve_schur", __FILE__);
@@ -79,7 +81,7 @@ StepSolution solve_schur(const LinearizedStep& step) {
 // TODO(lab07.5) [3 pts] The update: v ← v_new for every movable particle
 // (scatter `velocity` over map's unknowns), v = 0 for a pinned one, then
 // x ← x + Δt v. Throw std::invalid_argument before changing anything when dt
-// is not finite and > 0 or the sizes disagree (velocity must have 3u entries).
+// is not finite or ≤ 0 or the sizes disagree (velocity must have 3u entries).
 // Graded by tests/lab07_constrained_dynamics/test_physics.cpp (C = 0 meets
 // the linearised constraint, the hanging bead, the pendulum's period).
 void update_positions(Particles& particles, const MovableMap& map, const Eigen::VectorXd& velocity, double dt) {

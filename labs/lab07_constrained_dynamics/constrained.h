@@ -87,8 +87,8 @@ SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Sp
 // TODO(lab07.2) — assemble the KKT matrix and right-hand side above, with
 // M = diag(1 / inv_mass). The lower-right block holds C's non-zero entries
 // only (none at all when step.compliance is empty). Throws
-// std::invalid_argument when the sizes disagree, dt is not finite and > 0, or
-// an inverse mass is not finite and > 0.
+// std::invalid_argument when the sizes disagree, dt is not finite or ≤ 0, or
+// an inverse mass is not finite or ≤ 0.
 KktSystem kkt_system(const LinearizedStep& step);
 
 // TODO(lab07.3) — the primal-dual solve: factor system.matrix with a sparse LU
@@ -117,7 +117,7 @@ StepSolution solve_schur(const LinearizedStep& step);
 // TODO(lab07.5) — the update: x ← x + Δt v_new for every movable particle
 // (velocity is stacked over map's unknowns) and v ← v_new; pinned particles
 // keep their position and get v = 0. Throws std::invalid_argument, before
-// changing anything, when the sizes disagree or dt is not finite and > 0.
+// changing anything, when the sizes disagree or dt is not finite or ≤ 0.
 void update_positions(Particles& particles, const MovableMap& map, const Eigen::VectorXd& velocity, double dt);
 
 }  // namespace cl::lab07

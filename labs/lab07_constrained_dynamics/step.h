@@ -31,7 +31,7 @@ struct StepSettings {
 // hard ones. EMPTY when every spring is hard and regularization is 0: a scene
 // made only of hard constraints has no compliance block. Throws
 // std::invalid_argument for a stiffness that is not > 0 or a regularization
-// that is not finite and >= 0.
+// that is not finite or < 0.
 Eigen::VectorXd compliance_of(const std::vector<Spring>& springs, double regularization = 0.0);
 
 // The pieces of one step at the current state: φ and J (the student's

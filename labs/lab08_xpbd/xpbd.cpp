@@ -21,8 +21,10 @@ XpbdCorrection project_distance_xpbd(const Eigen::Vector3d& x_i, const Eigen::Ve
 }
 
 // TODO(lab08.2) [11 pts] One XPBD step: predict, reset λ, K sweeps, velocity update.
-// Validate as xpbd.h says (dt, iterations, sizes, spring and order indices,
-// stiffness via compliance()) before touching anything. Predict as in lab 04.
+// Validate as xpbd.h says (dt, iterations, sizes, inverse masses finite and
+// >= 0, spring and order indices, rest lengths finite and >= 0, stiffness via
+// compliance(), α̃ finite) before touching anything — particles or lambda: a
+// throw leaves both unchanged. Predict as in lab 04.
 // Set lambda to m zeros ONCE, then run settings.iterations sweeps; in each,
 // for s in constraints.order, call project_distance_xpbd on the predicted
 // positions with alpha_tilde = compliance(springs[s]) / dt² and lambda[s],

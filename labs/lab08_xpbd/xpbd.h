@@ -42,8 +42,9 @@ struct XpbdCorrection {
 //     Δλ   = (−C − α̃ λ) / (w_i + w_j + α̃)
 //     Δx_i = +w_i Δλ n
 //     Δx_j = −w_j Δλ n
-// After the move, C(x + Δx) + α̃ (λ + Δλ) = 0 up to round-off (the move is
-// along d, so the length changes by exactly (w_i + w_j) Δλ). With α̃ = 0 and
+// After the move, C′ + α̃ (λ + Δλ) = 0 up to round-off, where
+// C′ = ‖(x_i + Δx_i) − (x_j + Δx_j)‖ − L is the constraint after the move (the
+// move is along d, so the length changes by exactly (w_i + w_j) Δλ). With α̃ = 0 and
 // λ = 0 this is lab 01's project_distance. The centre of mass does not move.
 //
 // Degenerate input, never NaN:
@@ -81,9 +82,14 @@ struct XpbdSettings {
 // step, which XPBD neglects — README.md).
 //
 // Shapes: particles.x and .v are 3 × n, updated in place; inv_mass has n
-// entries. Throws std::invalid_argument, before changing anything, for dt not
-// finite and > 0, iterations < 0, v / inv_mass not sized for n particles, a
-// spring index or an `order` entry out of range, or a stiffness not > 0.
+// entries. Throws std::invalid_argument for dt not finite or ≤ 0, iterations
+// < 0, v / inv_mass not sized for n particles, an inverse mass that is
+// negative or not finite, a spring index or an `order` entry out of range, a
+// rest length that is negative or not finite, a stiffness not > 0, or an α̃
+// that is not finite (a compliance over a Δt so small that α̃ overflows) —
+// all of it checked before anything changes: on a throw the particles and
+// `lambda` are left exactly as they were, so nothing the sweeps'
+// project_distance_xpbd could reject is ever reached.
 void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, const XpbdSettings& settings,
                Eigen::VectorXd& lambda);
 

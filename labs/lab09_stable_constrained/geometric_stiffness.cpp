@@ -25,7 +25,7 @@ SparseMatrix geometric_stiffness(const Eigen::Matrix3Xd& x, const std::vector<Sp
   not_implemented("geometric_stiffness", __FILE__);
 }
 
-// TODO(lab09.2) [1 pt] Lab 07's KKT system with M − Δt² K_g in its upper-left
+// TODO(lab09.2) [2 pts] Lab 07's KKT system with M − Δt² K_g in its upper-left
 // 3u × 3u block: build lab07::kkt_system(step), then add −Δt²·K_g's entries
 // (as triplets at the same rows and columns, assembled to the KKT matrix's
 // size). Check that geometric_stiffness is 3u × 3u (std::invalid_argument).
@@ -38,7 +38,7 @@ lab07::KktSystem stiff_kkt_system(const lab07::LinearizedStep& step, const Spars
 // TODO(lab09.3) [3 pts] Eliminate λ (every c_e > 0):
 //     A = M − Δt² K_g + Δt² Jᵀ C⁻¹ J,      b = M(v + Δt g) − Δt Jᵀ C⁻¹ φ,
 // M = diag(1/step.inv_mass). Throw std::invalid_argument when compliance is
-// empty (with springs) or has an entry that is not > 0, when sizes disagree,
+// empty while there are springs (m > 0) or has an entry that is not > 0, when sizes disagree,
 // and for dt or inverse masses as lab07::kkt_system does.
 // Graded by tests/lab09_stable_constrained/test_eliminated.cpp: A equals
 // implicit Euler's M + Δt² H, b its right-hand side.

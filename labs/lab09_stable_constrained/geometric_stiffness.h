@@ -82,8 +82,10 @@ struct EliminatedSystem {
 // With K_g built from λ = −C⁻¹φ (Compression::kKeep) this is exactly
 // implicit Euler's (M + Δt² H) v_new = M(v + Δt g) + Δt f(x) for the same
 // springs. Throws std::invalid_argument like stiff_kkt_system, and when
-// step.compliance is empty or has an entry that is not > 0 (a hard constraint
-// cannot be eliminated this way: see solve_stiff_schur).
+// step.compliance is empty while there are springs (m > 0: every constraint
+// hard) or has an entry that is not > 0 (a hard constraint cannot be
+// eliminated this way: see solve_stiff_schur). With no springs there is
+// nothing to eliminate: the system is M − Δt² K_g, M(v + Δt g).
 EliminatedSystem eliminated_system(const lab07::LinearizedStep& step, const SparseMatrix& geometric_stiffness);
 
 // TODO(lab09.4) — the Schur-complement solve of the system above, with

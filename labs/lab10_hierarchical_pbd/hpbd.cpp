@@ -17,7 +17,7 @@ lab01::DistanceCorrection project_unilateral_distance(const Eigen::Vector3d& x_i
   not_implemented("project_unilateral_distance", __FILE__);
 }
 
-// TODO(lab10.2) [3 pts] Prolongation. Check the shapes and indices (throw
+// TODO(lab10.2) [4 pts] Prolongation. Check the shapes and indices (throw
 // std::invalid_argument). Then for every entry e with inv_mass[e.particle] > 0:
 //     x(e.particle) += Σ_k e.weights[k] · (x(e.parents[k]) − start(e.parents[k])).
 // Graded by tests/lab10_hierarchical_pbd/test_prolongation.cpp.
@@ -27,7 +27,7 @@ void prolong_corrections(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& start,
   not_implemented("prolong_corrections", __FILE__);
 }
 
-// TODO(lab10.3) [9 pts] The coarse-to-fine pass. Check the arguments first
+// TODO(lab10.3) [11 pts] The coarse-to-fine pass. Check the arguments first
 // (iterations.size() == number of levels, every count >= 0, every level's
 // inv_mass sized x.cols()). Keep start = x. For l = coarsest … 1: iterations[l]
 // Gauss-Seidel sweeps over hierarchy.levels[l].springs (file order) with
@@ -35,8 +35,10 @@ void prolong_corrections(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& start,
 // prolong_corrections(x, start, levels[l − 1].prolongation, levels[l − 1].inv_mass).
 // Finally iterations[0] sweeps of lab02::gauss_seidel_sweep over
 // levels[0].springs in file order (order 0, 1, …, m − 1) with levels[0].inv_mass.
-// Graded by tests/lab10_hierarchical_pbd/test_solve.cpp (4 pts),
-// test_at_rest.cpp (2 pts) and test_curtain.cpp (3 pts).
+// Graded by tests/lab10_hierarchical_pbd/test_solve.cpp (6 pts: the order, the
+// start, the coarse masses, the whole pass, one level, bad arguments),
+// test_at_rest.cpp (2 pts) and test_curtain.cpp (3 pts); all of them run your
+// lab10.1 and lab10.2 functions too.
 void solve_hierarchy(Eigen::Matrix3Xd& x, const ClothHierarchy& hierarchy, const std::vector<int>& iterations) {
   (void)x, (void)hierarchy, (void)iterations;
   not_implemented("solve_hierarchy", __FILE__);

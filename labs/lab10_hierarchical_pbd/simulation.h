@@ -28,7 +28,7 @@ long long projections_per_pass(const ClothHierarchy& hierarchy, const std::vecto
 // Lab 04's step with the hierarchical projection: for movable particles
 // v ← v + Δt g, p ← x + Δt v (pinned: p = x); solve_hierarchy(p); v ← (p − x)/Δt,
 // x ← p. With one level it is lab 04's Gauss-Seidel pbd_step. Throws
-// std::invalid_argument for dt not finite and > 0 (and whatever solve_hierarchy throws).
+// std::invalid_argument for dt not finite or ≤ 0 (and whatever solve_hierarchy throws).
 void hpbd_step(Particles& particles, const ClothHierarchy& hierarchy, const HpbdSettings& settings);
 
 // What one frame looked like after it was computed (frame 0: the initial state).
@@ -85,7 +85,7 @@ struct ConvergenceResult {
   std::vector<ConvergenceSample> samples;  // the prediction (all zero counts), then one per cloth sweep
   std::vector<TargetReached> targets;      // in the order given
 };
-// Throws std::invalid_argument for dt not finite and > 0, iterations not one
+// Throws std::invalid_argument for dt not finite or ≤ 0, iterations not one
 // per level, a negative count, iterations[0] < 1 or max_sweeps < 0.
 ConvergenceResult converge_one_step(const Particles& particles, const ClothHierarchy& hierarchy, double dt,
                                     const Eigen::Vector3d& gravity, const std::vector<int>& iterations,

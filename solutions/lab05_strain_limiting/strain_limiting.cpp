@@ -79,7 +79,9 @@ Eigen::Matrix3d limit_triangle_stretch(const Eigen::Matrix3d& corners, const Eig
                                        const TriangleRest& rest, double sigma_min, double sigma_max) {
   const Eigen::Vector3d weights = centroid_weights(inv_mass);
   require_rest_area(rest.area);
-  if (!rest.inverse_shape.allFinite()) throw std::invalid_argument("rest.inverse_shape must be finite");
+  // Both are used: D_m⁻¹ to form F, D_m for the rest corners.
+  if (!rest.shape.allFinite()) throw std::invalid_argument("rest.shape (D_m) must be finite");
+  if (!rest.inverse_shape.allFinite()) throw std::invalid_argument("rest.inverse_shape (D_m⁻¹) must be finite");
   require_band(sigma_min, sigma_max);
   const Eigen::Matrix3d none = Eigen::Matrix3d::Zero();
   const double weight_sum = weights.sum();

@@ -51,6 +51,13 @@ void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, co
   if (particles.v.cols() != n || particles.inv_mass.size() != n) {
     throw std::invalid_argument("xpbd_step: x, v and inv_mass disagree in size");
   }
+  for (Eigen::Index p = 0; p < n; ++p) {
+    const double w = particles.inv_mass[p];
+    if (!std::isfinite(w) || w < 0.0) {
+      throw std::invalid_argument("xpbd_step: inv_mass[" + std::to_string(p) + "] must be finite and >= 0 (got " +
+                                  std::to_string(w) + ")");
+    }
+  }
   const std::vector<Spring>& springs = constraints.springs;
   const auto spring_count = static_cast<int>(springs.size());
   std::vector<double> alpha_tilde(springs.size());
@@ -59,7 +66,15 @@ void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, co
     if (spring.i < 0 || spring.i >= n || spring.j < 0 || spring.j >= n) {
       throw std::invalid_argument("xpbd_step: spring " + std::to_string(s) + " has a particle index out of range");
     }
+    if (!std::isfinite(spring.rest_length) || spring.rest_length < 0.0) {
+      throw std::invalid_argument("xpbd_step: spring " + std::to_string(s) + " has rest length " +
+                                  std::to_string(spring.rest_length) + ", not finite and >= 0");
+    }
     alpha_tilde[s] = compliance(spring) / (dt * dt);
+    if (!std::isfinite(alpha_tilde[s])) {
+      throw std::invalid_argument("xpbd_step: spring " + std::to_string(s) + ": alpha_tilde = compliance / dt^2 "
+                                  "overflows at dt = " + std::to_string(dt));
+    }
   }
   for (const int s : constraints.order) {
     if (s < 0 || s >= spring_count) {

@@ -6,9 +6,8 @@
 #include <catch2/catch.hpp>
 
 #include "single_spring.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using cl::lab01::DistanceCorrection;
 using cl::lab01::project_distance;
 using Eigen::Vector3d;
@@ -49,7 +48,7 @@ void check_exact_length(double scale) {
     CAPTURE(scale, item.x_i.transpose(), item.x_j.transpose(), item.inv_mass_i, item.inv_mass_j, item.rest_length);
     const DistanceCorrection correction =
         project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
-    REQUIRE_THAT(projected_length(item, correction), WithinRel(item.rest_length, 1e-12));
+    REQUIRE(cl::test::near_rel(projected_length(item, correction), item.rest_length, 1e-12, "length after"));
   }
 }
 
@@ -70,11 +69,12 @@ TEST_CASE("the correction splits by inverse mass along the constraint", "[lab01]
     const DistanceCorrection correction =
         project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
     const double share_i = correction.dx_i.norm() / (correction.dx_i.norm() + correction.dx_j.norm());
-    REQUIRE_THAT(share_i, WithinRel(item.inv_mass_i / (item.inv_mass_i + item.inv_mass_j), 1e-12));
+    REQUIRE(cl::test::near_rel(share_i, item.inv_mass_i / (item.inv_mass_i + item.inv_mass_j), 1e-12,
+                                "share of end i, |dx_i| / (|dx_i| + |dx_j|)"));
     // Both corrections lie along d = x_i − x_j.
     const Vector3d d = item.x_i - item.x_j;
-    REQUIRE_THAT(d.cross(correction.dx_i).norm(), WithinAbs(0.0, 1e-12 * d.norm() * correction.dx_i.norm()));
-    REQUIRE_THAT(d.cross(correction.dx_j).norm(), WithinAbs(0.0, 1e-12 * d.norm() * correction.dx_j.norm()));
+    REQUIRE(cl::test::near(d.cross(correction.dx_i).norm(), 0.0, 1e-12 * d.norm() * correction.dx_i.norm(), "‖d × dx_i‖"));
+    REQUIRE(cl::test::near(d.cross(correction.dx_j).norm(), 0.0, 1e-12 * d.norm() * correction.dx_j.norm(), "‖d × dx_j‖"));
   }
 }
 
@@ -94,8 +94,9 @@ TEST_CASE("linear and angular momentum are unchanged even with a pinned end", "[
     const Vector3d angular =
         item.inv_mass_j * item.x_i.cross(correction.dx_i) + item.inv_mass_i * item.x_j.cross(correction.dx_j);
     const double scale = (item.inv_mass_i + item.inv_mass_j) * size;
-    REQUIRE_THAT(momentum.norm(), WithinAbs(0.0, 1e-13 * scale));
-    REQUIRE_THAT(angular.norm(), WithinAbs(0.0, 1e-13 * scale * (item.x_i.norm() + item.x_j.norm())));
+    REQUIRE(cl::test::near(momentum.norm(), 0.0, 1e-13 * scale, "‖w_j dx_i + w_i dx_j‖"));
+    REQUIRE(cl::test::near(angular.norm(), 0.0, 1e-13 * scale * (item.x_i.norm() + item.x_j.norm()),
+                           "‖w_j x_i × dx_i + w_i x_j × dx_j‖"));
   }
 }
 
@@ -105,14 +106,14 @@ TEST_CASE("one end pinned: the free end moves the whole way", "[lab01][pts=1]") 
   SECTION("pinned first") {
     const DistanceCorrection correction = project_distance(anchor, free_end, 0.0, 1.0 / 3.0, 1.0);
     REQUIRE(correction.dx_i == Vector3d::Zero());
-    REQUIRE_THAT(correction.dx_j.x(), WithinRel(-1.0, 1e-15));
+    REQUIRE(cl::test::near_rel(correction.dx_j.x(), -1.0, 1e-15, "dx_j.x"));
     REQUIRE(correction.dx_j.y() == 0.0);
     REQUIRE(correction.dx_j.z() == 0.0);
   }
   SECTION("pinned second") {
     const DistanceCorrection correction = project_distance(free_end, anchor, 5.0, 0.0, 0.5);
     REQUIRE(correction.dx_j == Vector3d::Zero());
-    REQUIRE_THAT(correction.dx_i.x(), WithinRel(-1.5, 1e-15));
+    REQUIRE(cl::test::near_rel(correction.dx_i.x(), -1.5, 1e-15, "dx_i.x"));
   }
 }
 

@@ -7,7 +7,7 @@
 #include <catch2/catch.hpp>
 
 #include "gauss_seidel.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 
 using cl::Spring;
 using Eigen::Matrix3Xd;
@@ -47,6 +47,6 @@ TEST_CASE("a sweep of a rotated and shifted configuration is the rotated and shi
     cl::lab02::gauss_seidel_sweep(x, inv_mass, springs, order);
     cl::lab02::gauss_seidel_sweep(moved, inv_mass, springs, order);
     const Matrix3Xd expected = (rotation * x).colwise() + shift;
-    REQUIRE(cl::test::difference(moved, expected) <= 1e-12);
+    REQUIRE(cl::test::near(moved, expected, 1e-12, "particle"));
   }
 }

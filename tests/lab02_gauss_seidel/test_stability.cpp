@@ -8,6 +8,7 @@
 #include "common/metrics.h"
 #include "common/scene.h"
 #include "gauss_seidel.h"
+#include "tests/support/checks.h"
 
 TEST_CASE("coincident particles and both ends pinned and a mass ratio of 1e6 stay finite", "[lab02][pts=1]") {
   for (const char* name : {"coincident-chain", "both-pinned", "mass-ratio-chain"}) {
@@ -24,7 +25,7 @@ TEST_CASE("coincident particles and both ends pinned and a mass ratio of 1e6 sta
       }
     }
     const double after = cl::strain_stats(x, scene.springs).max;
-    CAPTURE(name, before, after);
-    REQUIRE(after <= before);
+    CAPTURE(name);
+    REQUIRE(cl::test::at_most("max strain error after 10,000 sweeps (before them: the bound)", after, before));
   }
 }

@@ -50,6 +50,9 @@ TEST_CASE("every limiter rejects a bad band a bad rest shape and a bad inverse m
   cl::lab05::TriangleRest nan_rest = rest;
   nan_rest.inverse_shape(0, 1) = nan;
   REQUIRE_THROWS_AS(cl::lab05::limit_triangle_stretch(corners, ones, nan_rest, 0.9, 1.1), std::invalid_argument);
+  nan_rest = rest;  // D_m is used too (the rest corners): a NaN there throws as well
+  nan_rest.shape(1, 0) = nan;
+  REQUIRE_THROWS_AS(cl::lab05::limit_triangle_stretch(corners, ones, nan_rest, 0.9, 1.1), std::invalid_argument);
   for (const double inv_mass : {-1.0, nan, inf}) {
     CAPTURE(inv_mass);
     REQUIRE_THROWS_AS(cl::lab05::limit_spring(x_i, x_j, inv_mass, 1.0, 1.0, 0.9, 1.1), std::invalid_argument);

@@ -8,9 +8,8 @@
 #include <catch2/catch.hpp>
 
 #include "strain_limiting.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using cl::lab01::DistanceCorrection;
 using cl::lab05::limit_spring;
 using Eigen::Vector3d;
@@ -68,7 +67,7 @@ TEST_CASE("one spring limit brings the length to the nearer end of the band", "[
       CAPTURE(scale, item.x_i.transpose(), item.x_j.transpose(), item.inv_mass_i, item.inv_mass_j, item.rest_length,
               item.sigma_min, item.sigma_max, sigma);
       const double length = length_after(item, limit(item));
-      REQUIRE_THAT(length, WithinRel(target, 1e-12));
+      REQUIRE(cl::test::near_rel(length, target, 1e-12));
       REQUIRE(length >= item.sigma_min * item.rest_length * (1.0 - 1e-12));
       REQUIRE(length <= item.sigma_max * item.rest_length * (1.0 + 1e-12));
       outside += sigma < item.sigma_min || sigma > item.sigma_max;
@@ -101,7 +100,7 @@ TEST_CASE("a spring inside the band is untouched and a second limit changes noth
     again.x_i += first.dx_i;
     again.x_j += first.dx_j;
     const DistanceCorrection second = limit(again);
-    REQUIRE_THAT(second.dx_i.norm() + second.dx_j.norm(), WithinAbs(0.0, 1e-12 * item.rest_length));
+    REQUIRE(cl::test::near(second.dx_i.norm() + second.dx_j.norm(), 0.0, 1e-12 * item.rest_length));
   }
   REQUIRE(limited > 100);
 }
@@ -114,8 +113,7 @@ TEST_CASE("the spring limit keeps the centre of mass and never moves a pinned en
             item.sigma_min, item.sigma_max);
     const DistanceCorrection correction = limit(item);
     const double size = (item.x_i - item.x_j).norm() * (item.inv_mass_i + item.inv_mass_j);
-    REQUIRE_THAT((item.inv_mass_j * correction.dx_i + item.inv_mass_i * correction.dx_j).norm(),
-                 WithinAbs(0.0, 1e-12 * size));
+    REQUIRE(cl::test::near((item.inv_mass_j * correction.dx_i + item.inv_mass_i * correction.dx_j).norm(), 0.0, 1e-12 * size));
 
     // End i pinned: it stays exactly where it is, end j takes the whole correction.
     Case pinned = item;
@@ -123,7 +121,7 @@ TEST_CASE("the spring limit keeps the centre of mass and never moves a pinned en
     const DistanceCorrection one_pinned = limit(pinned);
     REQUIRE(one_pinned.dx_i == Vector3d::Zero());
     const double target = std::clamp(sigma_of(item), item.sigma_min, item.sigma_max) * item.rest_length;
-    REQUIRE_THAT(length_after(pinned, one_pinned), WithinRel(target, 1e-12));
+    REQUIRE(cl::test::near_rel(length_after(pinned, one_pinned), target, 1e-12));
 
     // Both pinned: nothing moves.
     pinned.inv_mass_j = 0.0;
@@ -155,8 +153,8 @@ TEST_CASE("the spring limit follows the two formulas of the notes for an unpinne
     // Round-off: relative to the correction, plus a few ulps of the length
     // (inside the band ℓ − σ₀L is itself round-off, and the answer is zero).
     const double tolerance = 1e-12 * std::abs(excess) + 1e-15 * length;
-    REQUIRE_THAT((correction.dx_i - expected_i).norm(), WithinAbs(0.0, tolerance));
-    REQUIRE_THAT((correction.dx_j - expected_j).norm(), WithinAbs(0.0, tolerance));
+    REQUIRE(cl::test::near(correction.dx_i, expected_i, tolerance));
+    REQUIRE(cl::test::near(correction.dx_j, expected_j, tolerance));
     checked += std::abs(excess) > 1e-9;
   }
   REQUIRE(checked > 150);

@@ -9,9 +9,8 @@
 
 #include "strain_limiting.h"
 #include "triangles.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using Eigen::Matrix3d;
 using Eigen::Vector2d;
 using Eigen::Vector3d;
@@ -61,8 +60,8 @@ TEST_CASE("the stretch limit puts both singular values of F in the band", "[lab0
       const Vector2d after =
           lab05_test::singular_values(lab05_test::world_deformation(item.corners + correction, item.rest));
       CAPTURE(after.transpose(), expected.transpose());
-      REQUIRE_THAT(after[0], WithinRel(expected[0], 1e-12));
-      REQUIRE_THAT(after[1], WithinRel(expected[1], 1e-12));
+      REQUIRE(cl::test::near_rel(after[0], expected[0], 1e-12));
+      REQUIRE(cl::test::near_rel(after[1], expected[1], 1e-12));
       moved += correction != Matrix3d::Zero();
     }
   }
@@ -94,18 +93,18 @@ TEST_CASE("the stretch limit keeps the mass-weighted centroid and the rotation o
     const Matrix3d correction = limit(item);
     const Vector3d weights = lab05_test::centroid_weights(item.inv_mass);
     const double size = (item.corners.colwise() - item.corners.rowwise().mean()).norm() * weights.sum();
-    REQUIRE_THAT((correction * weights).norm(), WithinAbs(0.0, 1e-12 * size));
+    REQUIRE(cl::test::near((correction * weights).norm(), 0.0, 1e-12 * size));
     for (int a = 0; a < 3; ++a) {
       if (item.inv_mass[a] == 0.0) {
         CAPTURE(a);
-        REQUIRE_THAT(correction.col(a).norm(), WithinAbs(0.0, 1e-12 * item.corners.norm()));
+        REQUIRE(cl::test::near(correction.col(a).norm(), 0.0, 1e-12 * item.corners.norm()));
       }
     }
     // The polar factor R = U Vᵀ of F (3 × 2) is unchanged.
     const F32 rotation_before = lab05_test::rotation_of(lab05_test::world_deformation(item.corners, item.rest));
     const F32 rotation_after =
         lab05_test::rotation_of(lab05_test::world_deformation(item.corners + correction, item.rest));
-    REQUIRE_THAT((rotation_after - rotation_before).cwiseAbs().maxCoeff(), WithinAbs(0.0, 1e-12));
+    REQUIRE(cl::test::near(rotation_after, rotation_before, 1e-12));
   }
 }
 
@@ -125,7 +124,7 @@ TEST_CASE("the stretch limit handles a turned-over and a zero-area triangle as t
   const Matrix3d none = cl::lab05::limit_triangle_stretch(turned, inv_mass, rest, 0.9, 1.1);
   CAPTURE(turned, none);
   REQUIRE(none.allFinite());
-  REQUIRE_THAT(none.cwiseAbs().maxCoeff(), WithinAbs(0.0, 1e-12));
+  REQUIRE(cl::test::near(none.cwiseAbs().maxCoeff(), 0.0, 1e-12));
 
   // Turned over and stretched 1.6 × along x, squeezed 0.5 × along y: limited
   // like any other, and it stays turned over (same normal as its input).
@@ -137,9 +136,9 @@ TEST_CASE("the stretch limit handles a turned-over and a zero-area triangle as t
   CAPTURE(turned_stretched, correction);
   REQUIRE(after.allFinite());
   const Vector2d stretches = lab05_test::singular_values(lab05_test::world_deformation(after, rest));
-  REQUIRE_THAT(stretches[0], WithinRel(1.1, 1e-12));
-  REQUIRE_THAT(stretches[1], WithinRel(0.9, 1e-12));
-  REQUIRE_THAT(lab05_test::normal_of(after).dot(lab05_test::normal_of(turned_stretched)), WithinAbs(1.0, 1e-12));
+  REQUIRE(cl::test::near_rel(stretches[0], 1.1, 1e-12));
+  REQUIRE(cl::test::near_rel(stretches[1], 0.9, 1e-12));
+  REQUIRE(cl::test::near(lab05_test::normal_of(after).dot(lab05_test::normal_of(turned_stretched)), 1.0, 1e-12));
 
   // Zero area: collinear corners (stretched far beyond the band), two
   // coincident corners, all three coincident. No frame: exactly zero, no NaN.

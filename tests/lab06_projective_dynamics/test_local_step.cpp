@@ -7,9 +7,8 @@
 #include <catch2/catch.hpp>
 
 #include "projective_dynamics.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using Eigen::Vector3d;
 
 TEST_CASE("the local step gives d of length L along x_i - x_j and a documented d for coincident ends",
@@ -40,14 +39,16 @@ TEST_CASE("the local step gives d of length L along x_i - x_j and a documented d
         REQUIRE(projected == Vector3d::Zero());
         continue;
       }
-      REQUIRE_THAT(projected.norm(), WithinRel(spring.rest_length, 1e-14));
+      REQUIRE(cl::test::near_rel(projected.norm(), spring.rest_length, 1e-14));
       // Same direction: d·edge = L‖edge‖ and d × edge = 0.
-      REQUIRE_THAT(projected.dot(edge), WithinRel(spring.rest_length * edge.norm(), 1e-14));
-      REQUIRE_THAT(projected.cross(edge).norm(), WithinAbs(0.0, 1e-14 * spring.rest_length * edge.norm()));
+      REQUIRE(cl::test::near_rel(projected.dot(edge), spring.rest_length * edge.norm(), 1e-14));
+      REQUIRE(cl::test::near(projected.cross(edge).norm(), 0.0, 1e-14 * spring.rest_length * edge.norm()));
     }
   }
-  // Coincident ends: d = L (1, 0, 0) exactly; ends so close that the length
-  // underflows: finite, never NaN.
+  // Coincident ends — the computed length is 0 (projective_dynamics.h) —:
+  // d = L (1, 0, 0) exactly. Ends 1e-160 m apart (subnormal squared length,
+  // the length off by up to 1e-3) and 1e-170 m apart (squared length 0:
+  // coincident by the rule): finite, never NaN, of length L.
   Eigen::Matrix3Xd x(3, 4);
   x.col(0) = Vector3d(0.3, -0.2, 0.7);
   x.col(1) = x.col(0);
@@ -61,8 +62,8 @@ TEST_CASE("the local step gives d of length L along x_i - x_j and a documented d
   REQUIRE(d.col(0) == Vector3d(0.25, 0.0, 0.0));
   REQUIRE(d.col(1) == Vector3d(2.0, 0.0, 0.0));
   REQUIRE(d.allFinite());
-  REQUIRE_THAT(d.col(2).norm(), WithinRel(0.5, 1e-3));
-  REQUIRE_THAT(d.col(3).norm(), WithinRel(0.5, 1e-3));
+  REQUIRE(cl::test::near_rel(d.col(2).norm(), 0.5, 1e-3));
+  REQUIRE(cl::test::near_rel(d.col(3).norm(), 0.5, 1e-3));
   REQUIRE(d.col(4) == Vector3d::Zero());
   // A spring index outside the positions is a bad argument.
   REQUIRE_THROWS_AS(cl::lab06::local_step(x, {{0, 4, 1.0, 1.0}}), std::invalid_argument);

@@ -8,9 +8,11 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 
 #include "common/constraints.h"
 #include "common/particles.h"
+#include "constrained.h"
 
 namespace lab07_test {
 
@@ -91,6 +93,48 @@ inline Difference largest_difference(const Eigen::VectorXd& a, const Eigen::Vect
     }
   }
   return d;
+}
+
+// Lab 07's KKT system written out densely from its blocks (constrained.h),
+//   [ M     −ΔtJᵀ ] [ v_new ]   [ M(v + Δtg) ]
+//   [ ΔtJ    C    ] [ λ     ] = [ −φ         ]
+// independently of the student's kkt_system, so that the solves' tests charge
+// a kkt_system mistake to lab07.2 alone.
+struct DenseKkt {
+  Eigen::MatrixXd matrix;
+  Eigen::VectorXd rhs;
+};
+inline DenseKkt dense_kkt(const cl::lab07::LinearizedStep& step) {
+  const Eigen::Index n3 = step.velocity.size(), m = step.phi.size();
+  const Eigen::MatrixXd jacobian(step.jacobian);
+  DenseKkt kkt;
+  kkt.matrix = Eigen::MatrixXd::Zero(n3 + m, n3 + m);
+  kkt.matrix.topLeftCorner(n3, n3) = step.inv_mass.cwiseInverse().asDiagonal();
+  kkt.matrix.topRightCorner(n3, m) = -step.dt * jacobian.transpose();
+  kkt.matrix.bottomLeftCorner(m, n3) = step.dt * jacobian;
+  if (step.compliance.size() == m) kkt.matrix.bottomRightCorner(m, m) = step.compliance.asDiagonal();
+  kkt.rhs.resize(n3 + m);
+  for (Eigen::Index k = 0; k < n3; ++k) kkt.rhs[k] = (step.velocity[k] + step.dt * step.gravity[k % 3]) / step.inv_mass[k];
+  kkt.rhs.tail(m) = -step.phi;
+  return kkt;
+}
+
+// The same system as a KktSystem, to hand to solve_kkt.
+inline cl::lab07::KktSystem sparse_kkt(const cl::lab07::LinearizedStep& step) {
+  const DenseKkt kkt = dense_kkt(step);
+  return cl::lab07::KktSystem{kkt.matrix.sparseView(), kkt.rhs};
+}
+
+// v_new and λ by a full-pivoting dense LU of that system: the expected values
+// of both solves (the scenes here have a unique solution).
+inline cl::lab07::StepSolution dense_kkt_solve(const cl::lab07::LinearizedStep& step) {
+  const DenseKkt kkt = dense_kkt(step);
+  const Eigen::VectorXd unknowns = kkt.matrix.fullPivLu().solve(kkt.rhs);
+  cl::lab07::StepSolution solution;
+  solution.velocity = unknowns.head(step.velocity.size());
+  solution.lambda = unknowns.tail(step.phi.size());
+  solution.ok = unknowns.allFinite();
+  return solution;
 }
 
 }  // namespace lab07_test

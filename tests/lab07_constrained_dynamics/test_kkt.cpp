@@ -10,8 +10,8 @@
 #include "constrained.h"
 #include "scenes_for_tests.h"
 #include "step.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
 
 namespace {
 
@@ -24,13 +24,6 @@ cl::lab07::LinearizedStep random_step(std::uint64_t seed, bool soft, std::string
   settings.gravity = Eigen::Vector3d(0.5, -9.81, 0.25);
   return cl::lab07::linearize(scene.particles, scene.springs, cl::make_movable_map(scene.particles.inv_mass),
                               settings);
-}
-
-// max |a − b| over the entries, with its position.
-std::string worst_entry(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, double& worst) {
-  Eigen::Index row = 0, col = 0;
-  worst = (a - b).cwiseAbs().maxCoeff(&row, &col);
-  return "largest difference at (" + std::to_string(row) + ", " + std::to_string(col) + ")";
 }
 
 }  // namespace
@@ -46,24 +39,10 @@ TEST_CASE("the KKT matrix is M and -dt J^T over dt J and C with right-hand side 
     REQUIRE(system.matrix.rows() == n3 + m);
     REQUIRE(system.matrix.cols() == n3 + m);
     REQUIRE(system.rhs.size() == n3 + m);
-    const Eigen::MatrixXd jacobian = Eigen::MatrixXd(step.jacobian);
-    Eigen::MatrixXd expected = Eigen::MatrixXd::Zero(n3 + m, n3 + m);
-    expected.topLeftCorner(n3, n3) = step.inv_mass.cwiseInverse().asDiagonal();
-    expected.topRightCorner(n3, m) = -step.dt * jacobian.transpose();
-    expected.bottomLeftCorner(m, n3) = step.dt * jacobian;
-    expected.bottomRightCorner(m, m) = step.compliance.asDiagonal();
-    double worst = 0.0;
-    const std::string where = worst_entry(Eigen::MatrixXd(system.matrix), expected, worst);
-    CAPTURE(where);
-    REQUIRE_THAT(worst, WithinAbs(0.0, 1e-12 * expected.cwiseAbs().maxCoeff()));
-    Eigen::VectorXd rhs(n3 + m);
-    for (Eigen::Index k = 0; k < n3; ++k) {
-      rhs[k] = (step.velocity[k] + step.dt * step.gravity[k % 3]) / step.inv_mass[k];
-    }
-    rhs.tail(m) = -step.phi;
-    const lab07_test::Difference d = lab07_test::largest_difference(system.rhs, rhs);
-    CAPTURE(d.index);
-    REQUIRE_THAT(d.value, WithinAbs(0.0, 1e-12 * rhs.cwiseAbs().maxCoeff()));
+    const lab07_test::DenseKkt expected = lab07_test::dense_kkt(step);
+    REQUIRE(cl::test::near(Eigen::MatrixXd(system.matrix), expected.matrix,
+                           1e-12 * expected.matrix.cwiseAbs().maxCoeff()));
+    REQUIRE(cl::test::near(system.rhs, expected.rhs, 1e-12 * expected.rhs.cwiseAbs().maxCoeff(), "rhs"));
   }
 }
 

@@ -11,7 +11,7 @@
 
 #include "pbd.h"
 #include "step.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 #include "xpbd.h"
 
 using Eigen::Matrix3Xd;
@@ -76,7 +76,7 @@ Steps step_both(const Chain& chain, double dt) {
   compliant.gravity = gravity;
   compliant.method = cl::lab07::Method::kSchur;
   const cl::lab07::StepResult result = cl::lab07::constrained_step(steps.lab07, chain.springs, compliant);
-  REQUIRE(result.ok);
+  REQUIRE(cl::test::solved(result));
   steps.lab07_force = result.lambda;
   return steps;
 }
@@ -126,10 +126,9 @@ TEST_CASE("with many iterations the XPBD step matches lab 07's compliant step", 
         const Chain chain = make_chain(rng, beads, false);
         const Steps steps = step_both(chain, dt);
         CAPTURE(beads, dt, steps.xpbd_force.transpose(), steps.lab07_force.transpose());
-        REQUIRE(cl::test::difference(steps.xpbd.x, steps.lab07.x) <= 1e-12);
-        REQUIRE(cl::test::difference(steps.xpbd.v, steps.lab07.v) <= 1e-12 / dt);
-        REQUIRE(cl::test::difference(steps.xpbd_force, steps.lab07_force) <=
-                1e-7 * steps.lab07_force.cwiseAbs().maxCoeff());
+        REQUIRE(cl::test::near(steps.xpbd.x, steps.lab07.x, 1e-12));
+        REQUIRE(cl::test::near(steps.xpbd.v, steps.lab07.v, 1e-12 / dt));
+        REQUIRE(cl::test::near(steps.xpbd_force, steps.lab07_force, 1e-7 * steps.lab07_force.cwiseAbs().maxCoeff()));
       }
     }
   }
@@ -145,8 +144,8 @@ TEST_CASE("with many iterations the XPBD step matches lab 07's compliant step", 
         const double allowed = bound(chain, steps.lab07) + 1e-13;
         CAPTURE(trial, dt, difference, allowed, chain.particles.x, chain.particles.v,
                 chain.particles.inv_mass.transpose());
-        REQUIRE(cl::test::difference(steps.xpbd.x, steps.lab07.x) <= allowed);
-        REQUIRE(cl::test::difference(steps.xpbd.v, steps.lab07.v) <= allowed / dt);
+        REQUIRE(cl::test::near(steps.xpbd.x, steps.lab07.x, allowed));
+        REQUIRE(cl::test::near(steps.xpbd.v, steps.lab07.v, allowed / dt));
         differences.push_back(difference);
       }
       // Second order: halving Δt from 1e-2 to 5e-3 divides the difference by about 4.

@@ -7,11 +7,9 @@
 #include <catch2/catch.hpp>
 
 #include "pbd.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 #include "xpbd.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using cl::lab04::ConstraintSet;
 using cl::lab08::XpbdSettings;
 using Eigen::Vector3d;
@@ -95,12 +93,12 @@ TEST_CASE("a single hanging spring settles at stretch mg over k for any dt and a
             const double scale = 1e-13 * (expected.norm() + dt * dt * g);
             CAPTURE(dt, iterations, stiffness, mass, expected.transpose(), particles.x.col(1).transpose(),
                     particles.v.col(1).transpose(), lambda);
-            REQUIRE_THAT((particles.x.col(1) - expected).norm(), WithinAbs(0.0, scale));
-            REQUIRE_THAT(particles.v.col(1).norm(), WithinAbs(0.0, scale / dt));
+            REQUIRE(cl::test::near(particles.x.col(1), expected, scale));
+            REQUIRE(cl::test::near(particles.v.col(1).norm(), 0.0, scale / dt));
             // λ/Δt² is the spring's force: minus the weight it carries. C = ℓ − L
             // loses about 1e-16·L/C of relative accuracy to cancellation.
             REQUIRE(lambda.size() == 1);
-            REQUIRE_THAT(lambda[0] / (dt * dt), WithinRel(-mass * g, 1e-6));
+            REQUIRE(cl::test::near_rel(lambda[0] / (dt * dt), -mass * g, 1e-6));
           }
         }
       }
@@ -127,8 +125,8 @@ TEST_CASE("a single hanging spring settles at stretch mg over k for any dt and a
         for (int step = 0; step < steps; ++step) cl::lab08::xpbd_step(particles, constraints, settings, lambda);
         const double stretch = total_stretch(particles, rest_length);
         CAPTURE(dt, iterations, steps, stretch, particles.x.col(1).transpose());
-        REQUIRE_THAT(stretch, WithinRel(mass * g / stiffness, 1e-9));
-        REQUIRE_THAT((particles.x.col(1).normalized() - down).norm(), WithinAbs(0.0, 1e-12));
+        REQUIRE(cl::test::near_rel(stretch, mass * g / stiffness, 1e-9));
+        REQUIRE(cl::test::near(particles.x.col(1).normalized(), down, 1e-12));
       }
     }
   }
@@ -162,12 +160,12 @@ TEST_CASE("a hanging chain of N beads settles at total stretch mgN(N+1)/(2k)", "
           const double expected = mass * g * beads * (beads + 1) / (2.0 * stiffness);
           const double scale = 1e-12 * (start.x.cwiseAbs().maxCoeff() + beads * dt * dt * g);
           CAPTURE(beads, dt, stiffness, settings.iterations, expected, lambda.transpose());
-          REQUIRE(cl::test::difference(particles.x, start.x) <= scale);
-          REQUIRE_THAT(total_stretch(particles, rest_length), WithinAbs(expected, beads * scale));
+          REQUIRE(cl::test::near(particles.x, start.x, scale));
+          REQUIRE(cl::test::near(total_stretch(particles, rest_length), expected, beads * scale));
           REQUIRE(lambda.size() == beads);
           for (int s = 0; s < beads; ++s) {
             CAPTURE(s);
-            REQUIRE_THAT(lambda[s] / (dt * dt), WithinRel(-(beads - s) * mass * g, 1e-6));
+            REQUIRE(cl::test::near_rel(lambda[s] / (dt * dt), -(beads - s) * mass * g, 1e-6));
           }
         }
       }
@@ -197,7 +195,7 @@ TEST_CASE("a hanging chain of N beads settles at total stretch mgN(N+1)/(2k)", "
       for (int step = 0; step < steps; ++step) cl::lab08::xpbd_step(particles, constraints, settings, lambda);
       const double expected = c.mass * g * c.beads * (c.beads + 1) / (2.0 * c.stiffness);
       CAPTURE(c.beads, c.mass, c.stiffness, c.dt, omega, steps, settings.iterations);
-      REQUIRE_THAT(total_stretch(particles, rest_length), WithinRel(expected, 1e-6));
+      REQUIRE(cl::test::near_rel(total_stretch(particles, rest_length), expected, 1e-6));
     }
   }
 }

@@ -12,9 +12,8 @@
 
 #include "single_spring.h"
 #include "xpbd.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using cl::lab08::project_distance_xpbd;
 using cl::lab08::XpbdCorrection;
 using Eigen::Vector3d;
@@ -69,10 +68,10 @@ TEST_CASE("with zero compliance and zero multiplier the XPBD projection is lab 0
         cl::lab01::project_distance(item.x_i, item.x_j, item.inv_mass_i, item.inv_mass_j, item.rest_length);
     const double scale = 1e-13 * (item.x_i.norm() + item.x_j.norm() + item.rest_length);
     CAPTURE(xpbd.dx_i.transpose(), pbd.dx_i.transpose(), xpbd.dx_j.transpose(), pbd.dx_j.transpose());
-    REQUIRE_THAT((xpbd.dx_i - pbd.dx_i).norm(), WithinAbs(0.0, scale));
-    REQUIRE_THAT((xpbd.dx_j - pbd.dx_j).norm(), WithinAbs(0.0, scale));
+    REQUIRE(cl::test::near(xpbd.dx_i, pbd.dx_i, scale));
+    REQUIRE(cl::test::near(xpbd.dx_j, pbd.dx_j, scale));
     const double constraint = (item.x_i - item.x_j).norm() - item.rest_length;
-    REQUIRE_THAT(xpbd.dlambda, WithinRel(-constraint / (item.inv_mass_i + item.inv_mass_j), 1e-12));
+    REQUIRE(cl::test::near_rel(xpbd.dlambda, -constraint / (item.inv_mass_i + item.inv_mass_j), 1e-12));
   }
 }
 
@@ -93,17 +92,15 @@ TEST_CASE("one XPBD projection solves C plus alpha_tilde times lambda equals zer
     const double residual = (after.x_i - after.x_j).norm() - item.rest_length + item.alpha_tilde * after.lambda;
     const double scale = item.x_i.norm() + item.x_j.norm() + item.rest_length +
                          item.alpha_tilde * (std::abs(item.lambda) + std::abs(correction.dlambda));
-    REQUIRE_THAT(residual, WithinAbs(0.0, 1e-13 * scale));
+    REQUIRE(cl::test::near(residual, 0.0, 1e-13 * scale));
 
     const Vector3d n = (item.x_i - item.x_j).normalized();
-    REQUIRE_THAT((correction.dx_i - item.inv_mass_i * correction.dlambda * n).norm(),
-                 WithinAbs(0.0, 1e-14 * (1.0 + correction.dx_i.norm())));
-    REQUIRE_THAT((correction.dx_j + item.inv_mass_j * correction.dlambda * n).norm(),
-                 WithinAbs(0.0, 1e-14 * (1.0 + correction.dx_j.norm())));
+    REQUIRE(cl::test::near((correction.dx_i - item.inv_mass_i * correction.dlambda * n).norm(), 0.0, 1e-14 * (1.0 + correction.dx_i.norm())));
+    REQUIRE(cl::test::near((correction.dx_j + item.inv_mass_j * correction.dlambda * n).norm(), 0.0, 1e-14 * (1.0 + correction.dx_j.norm())));
 
     const XpbdCorrection again = project(after);
     CAPTURE(again.dlambda);
-    REQUIRE_THAT(again.dlambda * (item.inv_mass_i + item.inv_mass_j + item.alpha_tilde), WithinAbs(0.0, 1e-13 * scale));
+    REQUIRE(cl::test::near(again.dlambda * (item.inv_mass_i + item.inv_mass_j + item.alpha_tilde), 0.0, 1e-13 * scale));
   }
 }
 
@@ -130,7 +127,7 @@ TEST_CASE("degenerate XPBD projections are no-ops and invalid input throws", "[l
     CAPTURE(correction.dx_i.transpose(), correction.dx_j.transpose(), correction.dlambda);
     REQUIRE(correction.dx_i == Vector3d::Zero());
     REQUIRE(correction.dx_j == Vector3d::Zero());
-    REQUIRE_THAT(correction.dlambda, WithinRel((-constraint - alpha_tilde * lambda) / alpha_tilde, 1e-14));
+    REQUIRE(cl::test::near_rel(correction.dlambda, (-constraint - alpha_tilde * lambda) / alpha_tilde, 1e-14));
   }
   SECTION("invalid arguments throw std::invalid_argument") {
     const double nan = std::numeric_limits<double>::quiet_NaN();

@@ -13,7 +13,7 @@
 
 #include "common/scene.h"
 #include "pbd.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 #include "xpbd.h"
 
 using cl::lab04::ConstraintSet;
@@ -99,10 +99,10 @@ TEST_CASE("one XPBD step is prediction then a lambda reset then K sweeps then th
     cl::lab08::xpbd_step(stepped, constraints, settings, lambda);
     REQUIRE(lambda.size() == expected_lambda.size());
     CAPTURE(lambda.transpose(), expected_lambda.transpose());
-    REQUIRE(cl::test::difference(stepped.x, p) <= 1e-12);
-    REQUIRE(cl::test::difference(stepped.v, expected_v) <= 1e-12 / settings.dt);
-    REQUIRE(cl::test::difference(lambda, expected_lambda) <= 1e-12 * (1.0 + expected_lambda.cwiseAbs().maxCoeff()));
-    REQUIRE(cl::test::difference(stepped.inv_mass, particles.inv_mass) == 0.0);
+    REQUIRE(cl::test::near(stepped.x, p, 1e-12));
+    REQUIRE(cl::test::near(stepped.v, expected_v, 1e-12 / settings.dt));
+    REQUIRE(cl::test::near(lambda, expected_lambda, 1e-12 * (1.0 + expected_lambda.cwiseAbs().maxCoeff())));
+    REQUIRE(cl::test::near(stepped.inv_mass, particles.inv_mass, 0.0));
   }
 }
 
@@ -140,8 +140,8 @@ TEST_CASE("with zero compliance the XPBD step is lab 04's Gauss-Seidel PBD step"
         cl::lab04::pbd_step(state, constraints, pbd);
         const double scale = state.x.cwiseAbs().maxCoeff() + dt * state.v.cwiseAbs().maxCoeff();
         CAPTURE(step, scale);
-        REQUIRE(cl::test::difference(by_xpbd.x, state.x) <= 1e-12 * scale);
-        REQUIRE(cl::test::difference(by_xpbd.v, state.v) <= 1e-12 * scale / dt);
+        REQUIRE(cl::test::near(by_xpbd.x, state.x, 1e-12 * scale));
+        REQUIRE(cl::test::near(by_xpbd.v, state.v, 1e-12 * scale / dt));
         REQUIRE(lambda.size() == static_cast<Eigen::Index>(scene.springs.size()));
       }
     }
@@ -156,8 +156,11 @@ TEST_CASE("invalid XPBD settings throw std::invalid_argument and change nothing"
   particles.inv_mass = VectorXd::Ones(2);
   const cl::Particles start = particles;
   const ConstraintSet constraints = cl::lab04::make_constraint_set(2, {cl::Spring{0, 1, 1.0, 50.0}});
-  VectorXd lambda;
-  auto unchanged = [&] { return particles.x == start.x && particles.v == start.v; };
+  VectorXd lambda = VectorXd::Constant(1, 7.0);  // an earlier step's λ: a throw must leave it
+  const VectorXd start_lambda = lambda;
+  auto unchanged = [&] {
+    return particles.x == start.x && particles.v == start.v && lambda.size() == 1 && lambda == start_lambda;
+  };
   for (const double dt : {0.0, -0.01, std::numeric_limits<double>::quiet_NaN(),
                           std::numeric_limits<double>::infinity()}) {
     CAPTURE(dt);
@@ -185,6 +188,26 @@ TEST_CASE("invalid XPBD settings throw std::invalid_argument and change nothing"
   cl::Particles wrong_size = particles;
   wrong_size.inv_mass = VectorXd::Ones(3);
   REQUIRE_THROWS_AS(cl::lab08::xpbd_step(wrong_size, constraints, settings, lambda), std::invalid_argument);
+  REQUIRE(unchanged());
+  // What the projection would reject is checked before the first sweep: the
+  // particles and λ stay as they were (not half a sweep later).
+  for (const double inv_mass : {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    CAPTURE(inv_mass);
+    particles.inv_mass[1] = inv_mass;
+    const cl::Particles bad_start = particles;
+    REQUIRE_THROWS_AS(cl::lab08::xpbd_step(particles, constraints, settings, lambda), std::invalid_argument);
+    REQUIRE((particles.x == bad_start.x && particles.v == bad_start.v && lambda == start_lambda));
+    particles.inv_mass[1] = 1.0;
+  }
+  for (const double rest : {-0.5, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    CAPTURE(rest);
+    const ConstraintSet bad = cl::lab04::make_constraint_set(2, {cl::Spring{0, 1, rest, 50.0}});
+    REQUIRE_THROWS_AS(cl::lab08::xpbd_step(particles, bad, settings, lambda), std::invalid_argument);
+    REQUIRE(unchanged());
+  }
+  XpbdSettings tiny = settings;  // α̃ = (1/50) / dt² overflows
+  tiny.dt = 1e-160;
+  REQUIRE_THROWS_AS(cl::lab08::xpbd_step(particles, constraints, tiny, lambda), std::invalid_argument);
   REQUIRE(unchanged());
   settings.iterations = 0;
   REQUIRE_NOTHROW(cl::lab08::xpbd_step(particles, constraints, settings, lambda));

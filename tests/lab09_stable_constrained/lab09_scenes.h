@@ -12,6 +12,7 @@
 
 #include "common/constraints.h"
 #include "common/particles.h"
+#include "common/sparse.h"
 
 namespace lab09_test {
 
@@ -70,6 +71,37 @@ RandomScene random_scene(std::mt19937_64& rng, int n, int pinned, int extra, Sti
   }
   scene.text = text.str();
   return scene;
+}
+
+// K_g written out from its closed form (geometric_stiffness.h): for spring e
+// with d = x_i − x_j, ℓ = ‖d‖, n = d/ℓ, the block B_e = λ_e (I − n nᵀ)/ℓ goes in
+// at +(i, i), +(j, j), −(i, j), −(j, i) over map's unknowns; pinned ends and
+// ℓ = 0 add nothing, and with `drop_compression` neither does λ_e > 0. The
+// tests of lab09.2–09.4 use this, not the student's geometric_stiffness, so a
+// K_g mistake is charged to lab09.1 alone.
+inline cl::SparseMatrix closed_form_stiffness(const Eigen::Matrix3Xd& x, const std::vector<cl::Spring>& springs,
+                                              const Eigen::VectorXd& lambda, const cl::MovableMap& map,
+                                              bool drop_compression) {
+  const Eigen::Index size = 3 * map.unknowns();
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(size, size);
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const double force = lambda[static_cast<Eigen::Index>(e)];
+    if (drop_compression && force > 0.0) continue;
+    const Eigen::Vector3d d = x.col(springs[e].i) - x.col(springs[e].j);
+    const double length = d.norm();
+    if (length == 0.0) continue;
+    const Eigen::Vector3d n = d / length;
+    const Eigen::Matrix3d block = force * (Eigen::Matrix3d::Identity() - n * n.transpose()) / length;
+    const int a = map.unknown_of[static_cast<std::size_t>(springs[e].i)];
+    const int b = map.unknown_of[static_cast<std::size_t>(springs[e].j)];
+    if (a >= 0) dense.block<3, 3>(3 * a, 3 * a) += block;
+    if (b >= 0) dense.block<3, 3>(3 * b, 3 * b) += block;
+    if (a >= 0 && b >= 0) {
+      dense.block<3, 3>(3 * a, 3 * b) -= block;
+      dense.block<3, 3>(3 * b, 3 * a) -= block;
+    }
+  }
+  return dense.sparseView();
 }
 
 }  // namespace lab09_test

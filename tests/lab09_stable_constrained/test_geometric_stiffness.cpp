@@ -13,9 +13,8 @@
 #include "constrained.h"
 #include "geometric_stiffness.h"
 #include "lab09_scenes.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
 using cl::lab09::Compression;
 
 namespace {
@@ -72,8 +71,8 @@ TEST_CASE("K_g matches central finite differences of J transpose lambda to 1e-6"
       }
     }
     const Eigen::MatrixXd actual(stiffness);
-    REQUIRE(cl::test::difference(actual, expected) <= 1e-6);
-    REQUIRE(cl::test::difference(actual, Eigen::MatrixXd(actual.transpose())) <= 1e-14);
+    REQUIRE(cl::test::near(actual, expected, 1e-6));
+    REQUIRE(cl::test::near(actual, Eigen::MatrixXd(actual.transpose()), 1e-14));
   }
 }
 
@@ -92,7 +91,7 @@ TEST_CASE("K_g drops compressed constraints and coincident ends and rejects a ba
     const Eigen::VectorXd tension = lambda.cwiseMin(0.0);
     const Eigen::MatrixXd kept_tension(
         cl::lab09::geometric_stiffness(x, scene.springs, tension, map, Compression::kKeep));
-    REQUIRE(cl::test::difference(dropped, kept_tension) <= 1e-12);
+    REQUIRE(cl::test::near(dropped, kept_tension, 1e-12));
     // Each tension block −λ(I − nnᵀ)/ℓ is positive semidefinite, and so is the sum −K_g.
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(-dropped, Eigen::EigenvaluesOnly);
     const double scale = std::max(1.0, dropped.cwiseAbs().maxCoeff());
@@ -121,7 +120,7 @@ TEST_CASE("K_g drops compressed constraints and coincident ends and rejects a ba
       const Eigen::MatrixXd with(cl::lab09::geometric_stiffness(particles.x, both, Eigen::Vector2d(-3.0, -7.0), map,
                                                                 compression));
       REQUIRE(with.allFinite());
-      REQUIRE(cl::test::difference(with, without) == 0.0);
+      REQUIRE(cl::test::near(with, without, 0.0));
     }
   }
 

@@ -9,9 +9,8 @@
 #include <catch2/catch.hpp>
 
 #include "hpbd.h"
+#include "tests/support/checks.h"
 
-using Catch::Matchers::WithinAbs;
-using Catch::Matchers::WithinRel;
 using Eigen::Vector3d;
 
 namespace {
@@ -44,11 +43,11 @@ TEST_CASE("a compressed constraint is left untouched and a stretched one is proj
     }
     // Stretched: back to the rest length, along the constraint, lighter end moves more.
     const Vector3d y_i = x_i + c.dx_i, y_j = x_j + c.dx_j;
-    REQUIRE_THAT((y_i - y_j).norm(), WithinRel(rest, 1e-12));
-    REQUIRE_THAT(c.dx_i.cross(direction).norm(), WithinAbs(0.0, 1e-12 * rest * ratio));
-    REQUIRE_THAT(c.dx_j.cross(direction).norm(), WithinAbs(0.0, 1e-12 * rest * ratio));
+    REQUIRE(cl::test::near_rel((y_i - y_j).norm(), rest, 1e-12));
+    REQUIRE(cl::test::near(c.dx_i.cross(direction).norm(), 0.0, 1e-12 * rest * ratio));
+    REQUIRE(cl::test::near(c.dx_j.cross(direction).norm(), 0.0, 1e-12 * rest * ratio));
     // Mass-weighted split: m_i Δx_i + m_j Δx_j = 0, i.e. w_j Δx_i = −w_i Δx_j.
-    REQUIRE_THAT((w_j * c.dx_i + w_i * c.dx_j).norm(), WithinAbs(0.0, 1e-12 * (w_i + w_j) * rest * ratio));
+    REQUIRE(cl::test::near((w_j * c.dx_i + w_i * c.dx_j).norm(), 0.0, 1e-12 * (w_i + w_j) * rest * ratio));
     REQUIRE(c.dx_i.dot(direction) < 0.0);  // x_i moves towards x_j
   }
   // Exactly at the rest length: inactive.
