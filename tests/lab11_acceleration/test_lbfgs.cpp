@@ -7,7 +7,7 @@
 #include <Eigen/Dense>
 
 #include "acceleration.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 
 using cl::lab11::CurvaturePair;
 using Eigen::MatrixXd;
@@ -70,7 +70,7 @@ TEST_CASE("the two-loop recursion equals the dense BFGS inverse update of the sa
     const VectorXd expected = -h * gradient;
     const VectorXd direction = cl::lab11::lbfgs_direction(gradient, pairs, initial);
     CAPTURE(trial, n, pairs.size());
-    REQUIRE(cl::test::difference(direction, expected) <= 1e-10 * expected.cwiseAbs().maxCoeff());
+    REQUIRE(cl::test::near(direction, expected, 1e-10 * expected.cwiseAbs().maxCoeff()));
     REQUIRE(gradient.dot(direction) < 0.0);  // a descent direction
   }
 }
@@ -85,17 +85,17 @@ TEST_CASE("without usable pairs the L-BFGS direction is minus the initial invers
   const VectorXd gradient = random_vector(rng, n);
   const VectorXd pd_direction = -a_factor.solve(gradient);
   // No pairs: d = −A⁻¹ ∇g, projective dynamics' step (README.md).
-  REQUIRE(cl::test::difference(cl::lab11::lbfgs_direction(gradient, {}, initial), pd_direction) <= 1e-15);
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(gradient, {}, initial), pd_direction, 1e-15));
   // Only pairs with sᵀy <= 0: all skipped, the same direction.
   std::vector<CurvaturePair> bad;
   const VectorXd s = random_vector(rng, n);
   bad.push_back({s, -s});
   bad.push_back({s, VectorXd::Zero(n)});  // sᵀy = 0 exactly
-  REQUIRE(cl::test::difference(cl::lab11::lbfgs_direction(gradient, bad, initial), pd_direction) <= 1e-15);
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(gradient, bad, initial), pd_direction, 1e-15));
   // One good pair: the secant condition H y = s, so the direction for ∇g = y is −s.
   const VectorXd y = a * s + random_spd(rng, n, 3.0) * s;
   const std::vector<CurvaturePair> one{{s, y}};
-  REQUIRE(cl::test::difference(cl::lab11::lbfgs_direction(y, one, initial), VectorXd(-s)) <= 1e-12);
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(y, one, initial), VectorXd(-s), 1e-12));
   // Refused: a pair of the wrong size.
   const std::vector<CurvaturePair> wrong{{VectorXd::Ones(n + 1), VectorXd::Ones(n + 1)}};
   REQUIRE_THROWS_AS(cl::lab11::lbfgs_direction(gradient, wrong, initial), std::invalid_argument);

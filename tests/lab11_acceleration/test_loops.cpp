@@ -13,7 +13,7 @@
 #include "accelerated.h"
 #include "common/scene.h"
 #include "pbd.h"
-#include "tests/support/matrix_checks.h"
+#include "tests/support/checks.h"
 
 using cl::lab11::Method;
 using Eigen::Matrix3Xd;
@@ -89,12 +89,12 @@ TEST_CASE("Chebyshev-accelerated PD converges to the plain PD and Newton minimis
       settings.delay = trial % 2 == 0 ? 1 : 10;
       const cl::Particles accelerated = run(c, Method::kPdChebyshev, settings);
       CAPTURE(rho, settings.delay);
-      REQUIRE(cl::test::difference(accelerated.x, newton.x) <= 1e-8 * motion);
-      REQUIRE(cl::test::difference(accelerated.v, newton.v) <= 1e-8 * motion / c.dt);
+      REQUIRE(cl::test::near(accelerated.x, newton.x, 1e-8 * motion));
+      REQUIRE(cl::test::near(accelerated.v, newton.v, 1e-8 * motion / c.dt));
     }
     settings.iterations = 20000;
     const cl::Particles plain = run(c, Method::kPd, settings);
-    REQUIRE(cl::test::difference(plain.x, newton.x) <= 1e-8 * motion);
+    REQUIRE(cl::test::near(plain.x, newton.x, 1e-8 * motion));
   }
 }
 
@@ -127,7 +127,7 @@ TEST_CASE("the objective after a restart never exceeds the objective before it a
     for (Eigen::Index p = 0; p < after.size(); ++p) {
       if (c.start.inv_mass[p] > 0.0) continue;
       CAPTURE(p);
-      REQUIRE(cl::test::difference(after.x.col(p), c.start.x.col(p)) == 0.0);
+      REQUIRE(cl::test::near(after.x.col(p), c.start.x.col(p), 0.0));
     }
   }
   // The same for accelerated Jacobi PBD (merit Σ strain²).
@@ -145,7 +145,7 @@ TEST_CASE("the objective after a restart never exceeds the objective before it a
     for (Eigen::Index p = 0; p < after.size(); ++p) {
       if (c.start.inv_mass[p] > 0.0) continue;
       CAPTURE(p);
-      REQUIRE(cl::test::difference(after.x.col(p), c.start.x.col(p)) == 0.0);
+      REQUIRE(cl::test::near(after.x.col(p), c.start.x.col(p), 0.0));
     }
   }
 }
@@ -163,8 +163,8 @@ TEST_CASE("rho = 0 reduces the accelerated PD and Jacobi PBD steps to the plain 
   settings.delay = 3;
   const cl::Particles plain = run(c, Method::kPd, settings);
   const cl::Particles accelerated = run(c, Method::kPdChebyshev, settings);
-  REQUIRE(cl::test::difference(accelerated.x, plain.x) == 0.0);
-  REQUIRE(cl::test::difference(accelerated.v, plain.v) == 0.0);
+  REQUIRE(cl::test::near(accelerated.x, plain.x, 0.0));
+  REQUIRE(cl::test::near(accelerated.v, plain.v, 0.0));
   // Jacobi PBD: lab 04's step with averaged Jacobi sweeps.
   cl::Particles lab04 = c.start;
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(c.start.size(), c.springs);
@@ -175,8 +175,8 @@ TEST_CASE("rho = 0 reduces the accelerated PD and Jacobi PBD steps to the plain 
   pbd.projection = cl::lab04::Projection::kJacobi;
   cl::lab04::pbd_step(lab04, constraints, pbd);
   const cl::Particles jacobi = run(c, Method::kJacobiChebyshev, settings);
-  REQUIRE(cl::test::difference(jacobi.x, lab04.x) == 0.0);
-  REQUIRE(cl::test::difference(jacobi.v, lab04.v) == 0.0);
+  REQUIRE(cl::test::near(jacobi.x, lab04.x, 0.0));
+  REQUIRE(cl::test::near(jacobi.v, lab04.v, 0.0));
 }
 
 TEST_CASE("L-BFGS with m = 0 is projective dynamics and on a quadratic objective converges in one iteration",
@@ -194,7 +194,7 @@ TEST_CASE("L-BFGS with m = 0 is projective dynamics and on a quadratic objective
       const cl::Particles pd = run(c, Method::kPd, settings);
       const cl::Particles lbfgs = run(c, Method::kPdLbfgs, settings);
       CAPTURE(iterations);
-      REQUIRE(cl::test::difference(lbfgs.x, pd.x) <= 1e-10 * (1.0 + moved(pd, c.start)));
+      REQUIRE(cl::test::near(lbfgs.x, pd.x, 1e-10 * (1.0 + moved(pd, c.start))));
     }
   }
   // Rest lengths 0: E = Σ k/2 ‖x_i − x_j‖², g is quadratic with Hessian A, and
@@ -236,7 +236,7 @@ TEST_CASE("converged L-BFGS equals the Newton minimiser to 1e-8 and g never rise
       std::vector<double> g;
       const cl::Particles lbfgs = run(c, Method::kPdLbfgs, settings, &g);
       CAPTURE(history, g.size());
-      REQUIRE(cl::test::difference(lbfgs.x, newton.x) <= 1e-8 * motion);
+      REQUIRE(cl::test::near(lbfgs.x, newton.x, 1e-8 * motion));
       for (std::size_t k = 1; k < g.size(); ++k) {
         CAPTURE(k, g[k - 1], g[k]);
         REQUIRE(g[k] <= g[k - 1] + 64.0 * 2.220446049250313e-16 * std::abs(g[k - 1]));

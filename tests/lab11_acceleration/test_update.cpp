@@ -7,8 +7,8 @@
 #include <catch2/catch.hpp>
 
 #include "acceleration.h"
+#include "tests/support/checks.h"
 #include "linear_splitting.h"
-#include "tests/support/matrix_checks.h"
 
 using Eigen::Matrix3Xd;
 
@@ -22,13 +22,12 @@ TEST_CASE("the accelerated update is omega (gamma (q_hat - q) + q - q_previous) 
     const double omega = 1.0 + 0.999 * unit(rng), gamma = 0.05 + 1.9 * unit(rng);
     CAPTURE(trial, omega, gamma);
     const Matrix3Xd expected = omega * (gamma * (q_hat - q) + q - q_previous) + q_previous;
-    REQUIRE(cl::test::difference(cl::lab11::chebyshev_update(q_hat, q, q_previous, omega, gamma), expected) <=
-            1e-14);
+    REQUIRE(cl::test::near(cl::lab11::chebyshev_update(q_hat, q, q_previous, omega, gamma), expected, 1e-14));
     // ω = γ = 1: the plain iterate, bit for bit.
-    REQUIRE(cl::test::difference(cl::lab11::chebyshev_update(q_hat, q, q_previous, 1.0, 1.0), q_hat) == 0.0);
+    REQUIRE(cl::test::near(cl::lab11::chebyshev_update(q_hat, q, q_previous, 1.0, 1.0), q_hat, 0.0));
     // ω = 1: the under-relaxed plain iterate q + γ (q_hat − q).
-    REQUIRE(cl::test::difference(cl::lab11::chebyshev_update(q_hat, q, q_previous, 1.0, gamma),
-                                 Matrix3Xd(q + gamma * (q_hat - q))) <= 1e-14);
+    REQUIRE(cl::test::near(cl::lab11::chebyshev_update(q_hat, q, q_previous, 1.0, gamma),
+                                 Matrix3Xd(q + gamma * (q_hat - q)), 1e-14));
   }
   const Matrix3Xd three = Matrix3Xd::Random(3, 3), four = Matrix3Xd::Random(3, 4);
   REQUIRE_THROWS_AS(cl::lab11::chebyshev_update(three, four, three, 1.2, 1.0), std::invalid_argument);
