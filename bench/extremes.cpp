@@ -298,7 +298,8 @@ int main(int argc, char** argv) {
   app.add_flag("--quick", options.quick, "CI size: 8 steps per cell, 2 with 10,000 iterations");
   app.add_option("--out", options.out, "folder for the CSV files")->capture_default_str();
   app.add_option("--methods", options.methods,
-                 "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles")
+                 "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles, "
+                 "pd-chebyshev, pd-lbfgs, jacobi-chebyshev")
       ->delimiter(',');
   app.add_option("--steps", options.steps, "steps per cell (default 120, quick 8)")->check(CLI::PositiveNumber);
   app.add_option("--long-steps", options.long_steps, "steps of the 10,000-iteration cells (default 12, quick 2)")

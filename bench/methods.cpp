@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <stdexcept>
 
 #include "common/hierarchy.h"
@@ -14,6 +15,7 @@
 #include "labs/lab08_xpbd/xpbd.h"
 #include "labs/lab09_stable_constrained/stable_step.h"
 #include "labs/lab10_hierarchical_pbd/simulation.h"
+#include "labs/lab11_acceleration/accelerated.h"
 
 namespace cl::bench {
 
@@ -40,6 +42,9 @@ const std::vector<MethodInfo>& all_methods() {
       {"schur-kg", "lab09", Family::kLinearized, false, false},
       {"limit-springs", "lab05", Family::kLimited, true, false},
       {"limit-triangles", "lab05", Family::kLimited, true, false},
+      {"pd-chebyshev", "lab11", Family::kImplicitEuler, true, false},
+      {"pd-lbfgs", "lab11", Family::kImplicitEuler, true, false},
+      {"jacobi-chebyshev", "lab11", Family::kHard, true, false},
   };
   return methods;
 }
@@ -227,6 +232,40 @@ class LimitedStepper : public Stepper {
   lab05::StepSettings settings_;
 };
 
+// Lab 11: PD accelerated by Chebyshev (ρ estimated once per scene from 400
+// plain iterations of its first step, as the lab's driver does) or by L-BFGS
+// with m = 5; Jacobi PBD by Chebyshev with γ = 0.9 (the lab's demo).
+class AcceleratedStepper : public Stepper {
+ public:
+  AcceleratedStepper(const Scene& scene, int iterations, lab11::Method method)
+      : solver_(scene.particles.inv_mass, scene.springs, scene.dt), method_(method) {
+    if (lab11::minimises_objective(method)) (void)lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+    if (method == lab11::Method::kJacobiChebyshev) settings_.gamma = 0.9;
+    if (method == lab11::Method::kPdChebyshev || method == lab11::Method::kJacobiChebyshev) {
+      const std::string key = scene.name + "/" + lab11::method_name(method) + "/" +
+                              std::to_string(scene.particles.size()) + "/" + std::to_string(scene.dt);
+      static std::map<std::string, double> estimates;  // the trade builds a stepper per K
+      auto found = estimates.find(key);
+      if (found == estimates.end()) {
+        const double rho = solver_.estimate_rho(scene.particles, method, settings_, 400);
+        found = estimates.emplace(key, rho < 1.0 ? rho : 0.0).first;
+      }
+      settings_.rho = found->second;
+    }
+  }
+  StepOutcome step(Particles& particles) override {
+    const lab11::StepReport report = solver_.step(particles, method_, settings_);
+    return {report.problem, report.iterations_done};
+  }
+
+ private:
+  lab11::Solver solver_;
+  lab11::Method method_;
+  lab11::Settings settings_;
+};
+
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations) {
@@ -241,6 +280,11 @@ std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& sc
   if (name == "schur") return std::make_unique<ConstrainedStepper>(scene, lab07::Method::kSchur);
   if (name == "schur-kg") return std::make_unique<StableStepper>(scene);
   if (name == "limit-springs") return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kSprings);
+  if (name == "pd-chebyshev") return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kPdChebyshev);
+  if (name == "pd-lbfgs") return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kPdLbfgs);
+  if (name == "jacobi-chebyshev") {
+    return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kJacobiChebyshev);
+  }
   return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kTrianglesStretch);
 }
 

@@ -57,7 +57,8 @@ struct Options {
 // The methods the trade compares (lab 05's limiter solves a different
 // problem again, explicit springs held in a band: only the extremes run it).
 const std::vector<std::string> kTradeMethods{"gs-pbd", "jacobi-pbd", "hpbd", "xpbd", "pd",
-                                             "newton", "kkt",        "schur", "schur-kg"};
+                                             "newton", "kkt",        "schur", "schur-kg",
+                                             "pd-chebyshev", "pd-lbfgs", "jacobi-chebyshev"};
 const std::vector<std::string> kAllScenes{"rope-100", "curtain-16", "curtain-32", "curtain-64", "curtain-128"};
 const std::vector<std::string> kQuickScenes{"rope-100", "curtain-16", "curtain-32"};
 
@@ -518,7 +519,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", options.out, "folder for the CSV files")->capture_default_str();
   app.add_option("--scenes", options.scenes, "rope-100, curtain-N (default: rope-100 and curtains 16 to 128)")
       ->delimiter(',');
-  app.add_option("--methods", options.methods, "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg")
+  app.add_option("--methods", options.methods,
+                 "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, pd-chebyshev, pd-lbfgs, jacobi-chebyshev")
       ->delimiter(',');
   app.add_option("--stiffness", options.stiffness, "every spring's stiffness, N/m")
       ->check(cl::finite_number(false))

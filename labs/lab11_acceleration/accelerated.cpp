@@ -1,0 +1,592 @@
+// Lab 11 — given code: the accelerated PD, L-BFGS and PBD loops, and the run.
+#include "accelerated.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "common/health.h"
+#include "common/metrics.h"
+#include "common/timer.h"
+#include "gauss_seidel.h"
+#include "jacobi.h"
+
+namespace cl::lab11 {
+
+namespace {
+
+constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+
+struct Named {
+  Method method;
+  const char* name;
+};
+constexpr Named kNames[] = {{Method::kPd, "pd"},
+                            {Method::kPdChebyshev, "pd-chebyshev"},
+                            {Method::kPdLbfgs, "pd-lbfgs"},
+                            {Method::kNewton, "newton"},
+                            {Method::kJacobi, "jacobi"},
+                            {Method::kJacobiChebyshev, "jacobi-chebyshev"},
+                            {Method::kGaussSeidel, "gauss-seidel"}};
+
+// lab 06's tolerance rule: the relative decrease fell below tol.
+bool decrease_below(double previous, double current, double tolerance) {
+  if (!(previous > 0.0)) return true;
+  return previous - current < tolerance * previous;
+}
+
+void check(const Settings& settings) {
+  if (settings.iterations < 0) throw std::invalid_argument("iterations must be >= 0");
+  if (!std::isfinite(settings.tolerance) || settings.tolerance < 0.0) {
+    throw std::invalid_argument("tolerance must be finite and >= 0");
+  }
+  if (!std::isfinite(settings.rho) || settings.rho < 0.0 || settings.rho >= 1.0) {
+    throw std::invalid_argument("rho must be in [0, 1) (got " + std::to_string(settings.rho) + ")");
+  }
+  if (!std::isfinite(settings.gamma) || !(settings.gamma > 0.0) || !(settings.gamma < 2.0)) {
+    throw std::invalid_argument("gamma must be in (0, 2) (got " + std::to_string(settings.gamma) + ")");
+  }
+  if (settings.delay < 1) throw std::invalid_argument("delay must be >= 1");
+  if (settings.history < 0) throw std::invalid_argument("history must be >= 0");
+}
+
+// A pinned particle is data, not an unknown: its column is put back after an
+// update that mixes iterates (the expanded form is not exact for equal inputs).
+void hold_pinned(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& held, const Eigen::VectorXd& inv_mass) {
+  for (Eigen::Index p = 0; p < x.cols(); ++p) {
+    if (!(inv_mass[p] > 0.0)) x.col(p) = held.col(p);
+  }
+}
+
+// The Chebyshev schedule of Wang (2015): ω = 1 before iteration S, then the
+// weights of acceleration.h counted from S (or from the last restart).
+struct Schedule {
+  double rho;
+  int delay;
+  int count = 0;  // j of the current iteration (0: not started)
+  double omega = 1.0;
+  double next(int k) {
+    if (k >= delay) ++count;
+    omega = chebyshev_weight(std::max(count, 1), rho, omega);
+    return omega;
+  }
+  void restart() {
+    count = 1;
+    omega = 1.0;
+  }
+};
+
+// Wall time of the method, without what is spent only for the records.
+struct Clock {
+  Timer timer;
+  double excluded = 0.0;
+  double seconds() const { return timer.seconds() - excluded; }
+};
+
+}  // namespace
+
+const char* method_name(Method method) {
+  for (const Named& named : kNames) {
+    if (named.method == method) return named.name;
+  }
+  return "?";
+}
+
+Method method_from_name(const std::string& name) {
+  for (const Named& named : kNames) {
+    if (name == named.name) return named.method;
+  }
+  throw std::invalid_argument("unknown method '" + name + "'");
+}
+
+bool minimises_objective(Method method) {
+  return method == Method::kPd || method == Method::kPdChebyshev || method == Method::kPdLbfgs ||
+         method == Method::kNewton;
+}
+
+Eigen::VectorXd apply_inverse(const SpdFactorization& factor, const Eigen::VectorXd& stacked) {
+  const Eigen::Index unknowns = stacked.size() / 3;
+  const RowsX3 rows = Eigen::Map<const RowsX3>(stacked.data(), unknowns, 3);
+  const RowsX3 solved = factor.solve3(rows);
+  return Eigen::Map<const Eigen::VectorXd>(solved.data(), stacked.size());
+}
+
+double strain_merit(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs) {
+  double merit = 0.0;
+  for (const Spring& spring : springs) {
+    const double strain = strain_error(x, spring);
+    merit += strain * strain;
+  }
+  return merit;
+}
+
+// ------------------------------------------------------------------ the solver
+
+Solver::Solver(Eigen::VectorXd inv_mass, std::vector<Spring> springs, double dt)
+    : inv_mass_(std::move(inv_mass)), springs_(std::move(springs)), dt_(dt) {
+  for (const Spring& spring : springs_) {
+    if (spring.i < 0 || spring.j < 0 || spring.i >= inv_mass_.size() || spring.j >= inv_mass_.size()) {
+      throw std::invalid_argument("Solver: a spring joins a particle outside [0, " +
+                                  std::to_string(inv_mass_.size()) + ")");
+    }
+  }
+  if (!std::isfinite(dt_) || !(dt_ > 0.0)) throw std::invalid_argument("Solver: dt must be finite and > 0");
+}
+
+void Solver::require_pd() {
+  if (problem_) return;
+  problem_ = lab06::make_problem(inv_mass_, springs_, dt_);
+  const Timer timer;
+  if (!factor_.factor(lab06::system_matrix(*problem_))) {
+    setup_problem_ = "the system matrix A = M/dt^2 + sum k S^T S is not positive definite to working precision";
+  }
+  factor_seconds_ += timer.seconds();
+  newton_ = std::make_unique<lab06::Solver>(*problem_, lab06::Method::kNewton);
+}
+
+const lab06::Problem& Solver::problem() {
+  require_pd();
+  return *problem_;
+}
+
+int Solver::factorizations() const {
+  return factor_.factorizations() + (newton_ ? newton_->factorizations() : 0);
+}
+
+StepReport Solver::step(Particles& particles, Method method, const Settings& settings,
+                        const IterationCallback& on_iteration) {
+  check(settings);
+  if (particles.size() != inv_mass_.size() || particles.v.cols() != particles.size()) {
+    throw std::invalid_argument("Solver::step: the particles do not match the solver's scene");
+  }
+  if (!minimises_objective(method)) return pbd(particles, method, settings, on_iteration);
+  require_pd();
+  const Timer timer;
+  StepReport report;
+  if (method == Method::kNewton) {
+    lab06::StepSettings newton_settings;
+    newton_settings.gravity = settings.gravity;
+    newton_settings.iterations = settings.iterations;
+    newton_settings.tolerance = settings.tolerance;
+    const lab06::StepReport done = newton_->step(particles, newton_settings, [&](const lab06::IterationRecord& r) {
+      IterationRecord record;
+      record.iteration = r.iteration;
+      record.objective = r.objective;
+      record.seconds = r.seconds;
+      return on_iteration ? on_iteration(record) : false;
+    });
+    report.iterations_done = done.iterations_done;
+    report.objective = done.objective;
+    report.converged = done.converged;
+    report.failed_line_searches = done.failed_decreases;
+    report.problem = done.problem;
+    report.seconds = timer.seconds();
+    return report;
+  }
+  const Eigen::Matrix3Xd y = lab06::predict(particles, settings.gravity, dt_);
+  Eigen::Matrix3Xd x = y;
+  report = minimise(x, y, method, settings, on_iteration);
+  if (report.problem.empty() && !all_finite(x)) report.problem = std::string(method_name(method)) + ": non-finite positions";
+  if (report.problem.empty()) {
+    for (Eigen::Index p = 0; p < particles.size(); ++p) {
+      particles.v.col(p) = inv_mass_[p] > 0.0 ? Eigen::Vector3d((x.col(p) - particles.x.col(p)) / dt_)
+                                              : Eigen::Vector3d::Zero();
+    }
+    particles.x = x;
+  }
+  report.seconds = timer.seconds();
+  return report;
+}
+
+StepReport Solver::minimise(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Method method, const Settings& settings,
+                            const IterationCallback& on_iteration) {
+  check(settings);
+  if (!minimises_objective(method) || method == Method::kNewton) {
+    throw std::invalid_argument(std::string("Solver::minimise: not for ") + method_name(method));
+  }
+  require_pd();
+  if (x.cols() != inv_mass_.size() || y.cols() != inv_mass_.size()) {
+    throw std::invalid_argument("Solver::minimise: x and y need one column per particle");
+  }
+  if (!setup_problem_.empty()) {
+    StepReport report;
+    report.problem = setup_problem_;
+    return report;
+  }
+  return method == Method::kPdLbfgs ? lbfgs_pd(x, y, settings, on_iteration)
+                                    : chebyshev_pd(x, y, method, settings, on_iteration);
+}
+
+// Plain PD (method kPd) or Chebyshev-accelerated PD: the objective is
+// evaluated every iteration for the restart rule (plain PD: only when a
+// record or the tolerance needs it).
+StepReport Solver::chebyshev_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Method method,
+                                const Settings& settings, const IterationCallback& on_iteration) {
+  const lab06::Problem& problem = *problem_;
+  const bool accelerated = method == Method::kPdChebyshev;
+  const bool tracked = accelerated || settings.tolerance > 0.0 || on_iteration;
+  StepReport report;
+  Clock clock;
+  auto record = [&](const IterationRecord& values) {
+    if (!on_iteration) return false;
+    const Timer timer;
+    IterationRecord copy = values;
+    copy.seconds = clock.seconds();
+    copy.max_strain = strain_stats(x, problem.springs).max;
+    const bool stop = on_iteration(copy);
+    clock.excluded += timer.seconds();
+    return stop;
+  };
+  double g = std::numeric_limits<double>::quiet_NaN();
+  bool stopped = false;
+  if (tracked) {
+    g = lab06::objective(problem, x, y);
+    stopped = record({0, g, 0.0, 1.0, false, 0.0});
+  }
+  Schedule schedule{settings.rho, settings.delay};
+  Eigen::Matrix3Xd previous = x;
+  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+    const Eigen::Matrix3Xd plain = lab06::global_step(problem, factor_, y, lab06::local_step(x, problem.springs));
+    IterationRecord values{k, 0.0, 0.0, 1.0, false, 0.0};
+    Eigen::Matrix3Xd next;
+    double value = std::numeric_limits<double>::quiet_NaN();
+    if (accelerated) {
+      values.omega = schedule.next(k);
+      if (values.omega == 1.0 && settings.gamma == 1.0) {
+        next = plain;  // the update would return q_hat bit for bit
+        value = lab06::objective(problem, next, y);
+      } else {
+        next = chebyshev_update(plain, x, previous, values.omega, settings.gamma);
+        hold_pinned(next, y, inv_mass_);
+        value = lab06::objective(problem, next, y);
+        if (restart_needed(g, value, kRestartSlack)) {
+          next = plain;
+          value = lab06::objective(problem, next, y);
+          values.restarted = true;
+          ++report.restarts;
+          schedule.restart();
+        }
+      }
+    } else {
+      next = plain;
+      if (tracked) {
+        const Timer timer;
+        value = lab06::objective(problem, next, y);
+        if (settings.tolerance == 0.0) clock.excluded += timer.seconds();
+      }
+    }
+    previous.swap(x);
+    x.swap(next);
+    report.iterations_done = k;
+    if (!all_finite(x)) {
+      report.problem = std::string(method_name(method)) + ": non-finite positions after iteration " + std::to_string(k);
+      return report;
+    }
+    if (!tracked) continue;
+    values.objective = value;
+    stopped = record(values);
+    const bool small = settings.tolerance > 0.0 && decrease_below(g, value, settings.tolerance);
+    g = value;
+    if (small) {
+      report.converged = true;
+      break;
+    }
+  }
+  report.objective = std::isnan(g) ? lab06::objective(problem, x, y) : g;
+  return report;
+}
+
+// L-BFGS on PD's matrix (Liu et al. 2017): the direction of the two-loop
+// recursion with H₀ = A⁻¹, then Armijo backtracking on g from the full step.
+StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const Settings& settings,
+                            const IterationCallback& on_iteration) {
+  const lab06::Problem& problem = *problem_;
+  const MovableMap& map = problem.map;
+  StepReport report;
+  Clock clock;
+  auto record = [&](int k, double value) {
+    if (!on_iteration) return false;
+    const Timer timer;
+    const bool stop = on_iteration({k, value, strain_stats(x, problem.springs).max, 1.0, false, clock.seconds()});
+    clock.excluded += timer.seconds();
+    return stop;
+  };
+  const InverseApply initial = [&](const Eigen::VectorXd& v) { return apply_inverse(factor_, v); };
+  auto moved = [&](const Eigen::VectorXd& direction, double alpha) {
+    Eigen::Matrix3Xd trial = x;
+    for (int u = 0; u < map.unknowns(); ++u) {
+      trial.col(map.particle_of[static_cast<std::size_t>(u)]) += alpha * direction.segment<3>(3 * u);
+    }
+    return trial;
+  };
+  std::deque<CurvaturePair> history;
+  double g = lab06::objective(problem, x, y);
+  Eigen::VectorXd gradient = lab06::newton_gradient(problem, x, y);
+  bool stopped = record(0, g);
+  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+    if (!gradient.allFinite()) {
+      report.problem = "pd-lbfgs iteration " + std::to_string(k) + ": the gradient is not finite";
+      break;
+    }
+    const std::vector<CurvaturePair> pairs(history.begin(), history.end());
+    Eigen::VectorXd direction = lbfgs_direction(gradient, pairs, initial);
+    double slope = gradient.dot(direction);
+    if (!(slope < 0.0) || !direction.allFinite()) {  // not a descent: forget the history, take PD's direction
+      history.clear();
+      direction = -initial(gradient);
+      slope = gradient.dot(direction);
+    }
+    if (!(slope < 0.0)) {  // ∇g = 0 to the last bit
+      report.converged = true;
+      break;
+    }
+    double alpha = 1.0;
+    Eigen::Matrix3Xd trial;
+    double value = 0.0;
+    Eigen::VectorXd next_gradient;
+    bool polish = !(-0.5 * slope > 8.0 * kEpsilon * std::abs(g));
+    if (!polish) {
+      bool accepted = false;
+      double full_step_value = 0.0;
+      for (int halving = 0; halving < 60; ++halving, alpha *= 0.5) {
+        trial = moved(direction, alpha);
+        value = lab06::objective(problem, trial, y);
+        if (halving == 0) full_step_value = value;
+        if (value <= g + 1e-4 * alpha * slope) {
+          accepted = true;
+          break;
+        }
+      }
+      if (!accepted) {
+        if (!(std::abs(full_step_value - g) <= 16.0 * kEpsilon * std::abs(g))) {
+          ++report.failed_line_searches;
+          break;
+        }
+        polish = true;  // within round-off of g: the objective cannot judge the step
+      }
+    }
+    if (polish) {
+      // The predicted decrease is at the round-off of g: the objective cannot
+      // tell where the minimum is any more, the gradient can. Full steps while
+      // they shrink the gradient and are above the round-off of x.
+      alpha = 1.0;
+      const double length = direction.cwiseAbs().maxCoeff();
+      if (length <= 64.0 * kEpsilon * x.cwiseAbs().maxCoeff()) {
+        report.converged = true;
+        break;
+      }
+      trial = moved(direction, 1.0);
+      value = lab06::objective(problem, trial, y);
+      next_gradient = lab06::newton_gradient(problem, trial, y);
+      if (!(next_gradient.norm() < gradient.norm())) {
+        report.converged = true;
+        break;
+      }
+    } else {
+      next_gradient = lab06::newton_gradient(problem, trial, y);
+    }
+    if (settings.history > 0) {
+      history.push_back({alpha * direction, next_gradient - gradient});
+      if (static_cast<int>(history.size()) > settings.history) history.pop_front();
+    }
+    x = trial;
+    gradient = next_gradient;
+    const double previous = g;
+    g = value;
+    report.iterations_done = k;
+    stopped = record(k, g);
+    if (settings.tolerance > 0.0 && decrease_below(previous, g, settings.tolerance)) {
+      report.converged = true;
+      break;
+    }
+  }
+  report.objective = g;
+  return report;
+}
+
+// PBD (lab 04's step) with the sweeps of lab 02 or lab 03, and Wang's
+// Chebyshev acceleration of the Jacobi sweeps.
+StepReport Solver::pbd(Particles& particles, Method method, const Settings& settings,
+                       const IterationCallback& on_iteration) {
+  if (!constraints_) constraints_ = lab04::make_constraint_set(inv_mass_.size(), springs_);
+  const lab04::ConstraintSet& constraints = *constraints_;
+  StepReport report;
+  Clock clock;
+  const Timer timer;
+  // lab 04's prediction, operation for operation (a plain run is its step bit for bit).
+  Eigen::Matrix3Xd p = particles.x;
+  for (Eigen::Index i = 0; i < p.cols(); ++i) {
+    if (inv_mass_[i] > 0.0) {
+      const Eigen::Vector3d velocity = particles.v.col(i) + dt_ * settings.gravity;
+      p.col(i) += dt_ * velocity;
+    }
+  }
+  const Eigen::Matrix3Xd held = p;
+  const bool accelerated = method == Method::kJacobiChebyshev;
+  auto record = [&](const IterationRecord& values) {
+    if (!on_iteration) return false;
+    const Timer timer_record;
+    IterationRecord copy = values;
+    copy.seconds = clock.seconds();
+    copy.max_strain = strain_stats(p, springs_).max;
+    if (!accelerated) copy.objective = strain_merit(p, springs_);
+    const bool stop = on_iteration(copy);
+    clock.excluded += timer_record.seconds();
+    return stop;
+  };
+  double merit = accelerated ? strain_merit(p, springs_) : 0.0;
+  bool stopped = record({0, merit, 0.0, 1.0, false, 0.0});
+  Schedule schedule{settings.rho, settings.delay};
+  Eigen::Matrix3Xd previous = p, plain(3, p.cols());
+  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+    IterationRecord values{k, 0.0, 0.0, 1.0, false, 0.0};
+    if (method == Method::kGaussSeidel) {
+      lab02::gauss_seidel_sweep(p, inv_mass_, springs_, constraints.order);
+    } else {
+      lab03::jacobi_sweep(p, plain, inv_mass_, springs_, constraints.incidence, 1.0, lab03::Averaging::kByCount);
+      if (!accelerated) {
+        p.swap(plain);
+      } else {
+        values.omega = schedule.next(k);
+        Eigen::Matrix3Xd next = plain;
+        if (values.omega != 1.0 || settings.gamma != 1.0) {
+          next = chebyshev_update(plain, p, previous, values.omega, settings.gamma);
+          hold_pinned(next, held, inv_mass_);
+        }
+        double value = strain_merit(next, springs_);
+        if (restart_needed(merit, value, kRestartSlack) && (values.omega != 1.0 || settings.gamma != 1.0)) {
+          next = plain;
+          value = strain_merit(next, springs_);
+          values.restarted = true;
+          ++report.restarts;
+          schedule.restart();
+        }
+        merit = value;
+        values.objective = value;
+        previous.swap(p);
+        p.swap(next);
+      }
+    }
+    report.iterations_done = k;
+    if (!all_finite(p)) {
+      report.problem = std::string(method_name(method)) + ": non-finite positions after sweep " + std::to_string(k);
+      return report;
+    }
+    stopped = record(values);
+  }
+  report.objective = strain_merit(p, springs_);
+  particles.v = (p - particles.x) / dt_;
+  particles.x = p;
+  report.seconds = timer.seconds();
+  return report;
+}
+
+double Solver::estimate_rho(const Particles& start, Method method, const Settings& settings, int iterations) {
+  if (iterations < 2) throw std::invalid_argument("estimate_rho: needs at least 2 iterations");
+  std::vector<double> norms;
+  // The update lengths; stop before round-off (a length below 1e-12 of the
+  // positions' size would measure noise, not the rate).
+  const double scale = std::max(start.x.cwiseAbs().maxCoeff(), 1e-300);
+  const Particles& particles = start;
+  if (minimises_objective(method)) {
+    require_pd();
+    if (!setup_problem_.empty()) return 0.0;
+    const Eigen::Matrix3Xd y = lab06::predict(particles, settings.gravity, dt_);
+    Eigen::Matrix3Xd x = y;
+    for (int k = 0; k < iterations; ++k) {
+      const Eigen::Matrix3Xd next = lab06::global_step(*problem_, factor_, y, lab06::local_step(x, problem_->springs));
+      const double length = (next - x).norm();
+      if (!std::isfinite(length) || length <= 1e-12 * scale) break;
+      norms.push_back(length);
+      x = next;
+    }
+  } else {
+    if (!constraints_) constraints_ = lab04::make_constraint_set(inv_mass_.size(), springs_);
+    Eigen::Matrix3Xd p = particles.x;
+    for (Eigen::Index i = 0; i < p.cols(); ++i) {
+      if (inv_mass_[i] > 0.0) {
+        const Eigen::Vector3d velocity = particles.v.col(i) + dt_ * settings.gravity;
+        p.col(i) += dt_ * velocity;
+      }
+    }
+    Eigen::Matrix3Xd next(3, p.cols());
+    for (int k = 0; k < iterations; ++k) {
+      lab03::jacobi_sweep(p, next, inv_mass_, springs_, constraints_->incidence, 1.0, lab03::Averaging::kByCount);
+      const double length = (next - p).norm();
+      if (!std::isfinite(length) || length <= 1e-12 * scale) break;
+      norms.push_back(length);
+      p.swap(next);
+    }
+  }
+  if (norms.size() < 2) return 0.0;
+  return estimate_spectral_radius(norms);
+}
+
+// ------------------------------------------------------------------ a run
+
+namespace {
+
+// PBD treats springs as hard constraints: their energy is not the scene's.
+double total_energy(const Particles& particles, const std::vector<Spring>& springs, const Eigen::Vector3d& gravity,
+                    bool elastic) {
+  const double motion = kinetic_energy(particles) + potential_energy(particles, gravity);
+  return elastic ? motion + lab06::spring_energy(particles.x, springs) : motion;
+}
+
+}  // namespace
+
+RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
+                    const StepCallback& on_step, const RunIterationCallback& on_iteration) {
+  if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
+  const std::vector<Spring>& springs = solver.springs();
+  const bool elastic = minimises_objective(method);
+  RunResult result;
+  StepRecord record;
+  record.strain = strain_stats(particles.x, springs);
+  record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
+  result.energy_start = result.energy_end = record.total_energy;
+  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
+                       (elastic ? lab06::spring_energy(particles.x, springs) : 0.0);
+  record.problem = health_problem(particles, record.strain);
+  if (on_step) on_step(record, particles);
+  if (!record.problem.empty()) {
+    result.problem = record.problem;
+    result.problem_step = 0;
+    return result;
+  }
+  for (int s = 1; s <= steps; ++s) {
+    record = StepRecord{};
+    record.step = s;
+    IterationCallback each = nullptr;
+    if (on_iteration) {
+      each = [&](const IterationRecord& iteration) {
+        on_iteration(s, iteration);
+        return false;
+      };
+    }
+    record.report = solver.step(particles, method, settings, each);
+    result.seconds += record.report.seconds;
+    result.iterations_done += record.report.iterations_done;
+    result.restarts += record.report.restarts;
+    result.failed_line_searches += record.report.failed_line_searches;
+    result.steps_done = s;
+    record.strain = strain_stats(particles.x, springs);
+    record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
+    result.energy_end = record.total_energy;
+    record.problem = record.report.problem;
+    if (record.problem.empty()) record.problem = health_problem(particles, record.strain);
+    if (record.problem.empty()) record.problem = energy_rise_problem(result.energy_end - result.energy_start, scale);
+    if (on_step) on_step(record, particles);
+    if (!record.problem.empty()) {
+      result.problem = record.problem;
+      result.problem_step = s;
+      return result;
+    }
+  }
+  return result;
+}
+
+}  // namespace cl::lab11

@@ -1,0 +1,198 @@
+// lab11_acceleration: projective dynamics accelerated by Chebyshev (Wang 2015)
+// and by L-BFGS on PD's matrix (Liu et al. 2017); Jacobi PBD by Chebyshev.
+//   default        run the scene's steps: iterations.csv (every iteration of
+//                  every step) and the run summary
+//   --convergence  one step from the scene's start, to the minimum:
+//                  convergence.csv (objective_error = (g − g*)/g*, g* lab 06's
+//                  Newton minimum; max_strain for PBD) and a table of the
+//                  iterations and seconds to each target
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "accelerated.h"
+#include "common/cli.h"
+#include "common/csv.h"
+#include "common/output.h"
+#include "common/summary.h"
+
+namespace {
+
+using cl::lab11::Method;
+constexpr const char* kLab = CL_LAB_NAME;
+
+struct LabOptions {
+  cl::lab11::Settings settings;
+  bool estimate = true;  // no --rho: measure it on the scene
+  bool convergence = false;
+  std::vector<std::string> sweep_scenes;
+  double strain_target = 1e-3;
+  int estimate_iterations = 400;
+};
+
+cl::Scene load(const cl::CommonOptions& options, const std::string& name, Method method) {
+  cl::CommonOptions one = options;
+  one.scene = name;
+  cl::Scene scene = cl::load_scene_for(one, CL_LAB_SCENE_DIR);
+  for (std::size_t e = 0; cl::lab11::minimises_objective(method) && e < scene.springs.size(); ++e) {
+    if (!std::isfinite(scene.springs[e].stiffness)) {
+      throw cl::InputError(scene.source + ": springs[" + std::to_string(e) + "].stiffness: inf is a hard constraint; " +
+                           cl::lab11::method_name(method) + " needs finite springs (or a PBD method)");
+    }
+  }
+  return scene;
+}
+
+// --rho, or ρ measured on the scene's first step (Wang: once per scene); 0 for
+// the methods without Chebyshev.
+double rho_for(cl::lab11::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
+  if (!lab.estimate) return lab.settings.rho;
+  if (method != Method::kPdChebyshev && method != Method::kJacobiChebyshev) return 0.0;
+  cl::lab11::Settings settings = lab.settings;
+  settings.gravity = scene.gravity;
+  const double rho = solver.estimate_rho(scene.particles, method, settings, lab.estimate_iterations);
+  if (rho < 1.0) return rho;
+  std::printf("  estimated rho %.6f >= 1 (the plain iteration does not converge): no acceleration (rho 0)\n", rho);
+  return 0.0;
+}
+
+int run_steps(const cl::CommonOptions& options, LabOptions lab) {
+  const Method method = cl::lab11::method_from_name(options.method);
+  cl::Scene scene = load(options, options.scene, method);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+  cl::lab11::Settings& settings = lab.settings;
+  settings.gravity = scene.gravity;
+  settings.iterations = options.iterations;
+  settings.rho = rho_for(solver, scene, method, lab);
+  cl::CsvTable table({"step", "iteration", "objective", "max_strain", "omega", "restarted", "seconds"});
+  const cl::lab11::RunIterationCallback on_iteration = [&](int step, const cl::lab11::IterationRecord& r) {
+    table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.max_strain,
+                   r.omega, static_cast<long long>(r.restarted), r.seconds});
+  };
+  cl::Particles& particles = scene.particles;
+  const cl::lab11::RunResult result = cl::lab11::run_steps(particles, solver, method, settings, scene.steps, nullptr,
+                                                           options.out.empty() ? nullptr : on_iteration);
+  const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+  const bool chebyshev = method == Method::kPdChebyshev || method == Method::kJacobiChebyshev;
+  std::printf("%s: scene %s, %s, K = %d, rho %.6f%s, gamma %g, delay %d, history %d, %d steps of %.4g s\n", kLab,
+              scene.name.c_str(), options.method.c_str(), options.iterations, settings.rho,
+              !chebyshev ? " (not used)" : lab.estimate ? " (estimated)" : "", settings.gamma, settings.delay,
+              settings.history, scene.steps, scene.dt);
+  if (!result.problem.empty()) std::printf("  DIVERGED at step %d: %s\n", result.problem_step, result.problem.c_str());
+  std::printf("  max strain %.3e, rms %.3e; %lld iterations, %d restarts, %d failed line searches; %.3e s (%.3e s "
+              "per step)\n", strain.max, strain.rms, result.iterations_done, result.restarts,
+              result.failed_line_searches, result.seconds, result.steps_done ? result.seconds / result.steps_done : 0.0);
+  if (!options.out.empty()) table.write(cl::join_path(options.out, "iterations.csv"));
+  if (!options.summary.empty()) {
+    cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
+    summary.iterations = options.iterations;
+    summary.extra["rho"] = settings.rho;
+    summary.extra["rho_estimated"] = lab.estimate;
+    summary.extra["gamma"] = settings.gamma;
+    summary.extra["delay"] = settings.delay;
+    summary.extra["history"] = settings.history;
+    summary.extra["restarts"] = result.restarts;
+    summary.extra["iterations_done"] = result.iterations_done;
+    summary.extra["failed_line_searches"] = result.failed_line_searches;
+    cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
+    cl::write_summary(options.summary, summary);
+  }
+  return 0;
+}
+
+int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
+  if (!options.summary.empty()) throw cl::InputError("--summary: --convergence writes CSV files, not a run summary");
+  const Method method = cl::lab11::method_from_name(options.method);
+  const bool pd = cl::lab11::minimises_objective(method);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::CsvTable table({"scene", "method", "rho", "history", "iteration", "objective", "objective_error", "max_strain",
+                      "omega", "restarted", "seconds", "setup_seconds"});
+  const std::vector<double> targets = pd ? std::vector<double>{1e-2, 1e-4, 1e-6} : std::vector<double>{lab.strain_target};
+  for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene} : lab.sweep_scenes) {
+    const cl::Scene scene = load(options, name, method);
+    cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+    cl::lab11::Settings settings = lab.settings;
+    settings.gravity = scene.gravity;
+    settings.rho = rho_for(solver, scene, method, lab);
+    double best = 0.0;  // g*: lab 06's Newton to round-off
+    if (pd) {
+      cl::lab11::Settings newton = settings;
+      newton.iterations = 50;
+      newton.tolerance = 1e-15;
+      cl::Particles reference = scene.particles;
+      best = solver.step(reference, Method::kNewton, newton).objective;
+    }
+    settings.iterations = options.iterations;
+    std::vector<int> reached_at(targets.size(), -1);
+    std::vector<double> seconds_at(targets.size(), 0.0);
+    const double setup = method == Method::kNewton ? 0.0 : solver.factor_seconds();
+    cl::Particles particles = scene.particles;
+    const cl::lab11::StepReport report = solver.step(particles, method, settings, [&](const cl::lab11::IterationRecord& r) {
+      const double error = pd ? (r.objective - best) / std::abs(best) : r.max_strain;
+      table.add_row({scene.name, options.method, settings.rho, static_cast<long long>(settings.history),
+                     static_cast<long long>(r.iteration), r.objective, pd ? error : 0.0, r.max_strain, r.omega,
+                     static_cast<long long>(r.restarted), r.seconds + setup, setup});
+      bool all = true;
+      for (std::size_t t = 0; t < targets.size(); ++t) {
+        if (reached_at[t] < 0 && error <= targets[t]) reached_at[t] = r.iteration, seconds_at[t] = r.seconds + setup;
+        all = all && reached_at[t] >= 0;
+      }
+      return all && pd;  // PBD runs its K sweeps, to show where the strain settles
+    });
+    std::printf("%-16s %-16s rho %.6f m %2d:", scene.name.c_str(), options.method.c_str(), settings.rho,
+                settings.history);
+    for (std::size_t t = 0; t < targets.size(); ++t) {
+      if (reached_at[t] >= 0) {
+        std::printf("  %s %g: %5d its %9.3g s", pd ? "error" : "strain", targets[t], reached_at[t], seconds_at[t]);
+      } else {
+        std::printf("  %s %g: not in %d", pd ? "error" : "strain", targets[t], report.iterations_done);
+      }
+    }
+    std::printf("  restarts %d%s%s\n", report.restarts, report.problem.empty() ? "" : "; ", report.problem.c_str());
+    std::fflush(stdout);
+  }
+  if (!options.out.empty()) table.write(cl::join_path(options.out, "convergence.csv"));
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Lab 11: projective dynamics accelerated by Chebyshev and by L-BFGS on PD's matrix, and Jacobi PBD "
+               "by Chebyshev. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
+  cl::CommonOptions options;
+  options.scene = "pd-curtain-16";
+  options.method = "pd-chebyshev";
+  options.methods = {"pd", "pd-chebyshev", "pd-lbfgs", "newton", "jacobi", "jacobi-chebyshev", "gauss-seidel"};
+  options.iterations = 10;
+  cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
+                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary);
+  LabOptions lab;
+  double rho = -1.0;
+  app.add_option("--rho", rho, "the spectral radius for Chebyshev, in [0, 1) (default: estimated per scene)")
+      ->check(cl::finite_number(true));
+  app.add_option("--gamma", lab.settings.gamma, "Chebyshev's under-relaxation, in (0, 2)")
+      ->check(cl::finite_number(false))->capture_default_str();
+  app.add_option("--delay", lab.settings.delay, "S: plain iterations before Chebyshev starts (>= 1)")
+      ->check(CLI::Range(1, 1'000'000))->capture_default_str();
+  app.add_option("--history", lab.settings.history, "m: L-BFGS pairs kept (>= 0)")
+      ->check(CLI::Range(0, 1000))->capture_default_str();
+  app.add_option("--tolerance", lab.settings.tolerance,
+                 "stop a step once the objective's relative decrease falls below this (0: run all K; PD methods)")
+      ->check(cl::finite_number(true))->capture_default_str();
+  app.add_option("--estimate-iterations", lab.estimate_iterations, "plain iterations that estimate rho (no --rho)")
+      ->check(CLI::Range(2, 1'000'000))->capture_default_str();
+  app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
+  app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)")->delimiter(',');
+  app.add_option("--strain-target", lab.strain_target, "--convergence, PBD methods: the max strain to reach")
+      ->check(cl::finite_number(false))->capture_default_str();
+  return cl::run_main(app, argc, argv, [&] {
+    if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1) (the iteration would not converge)");
+    if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");
+    if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
+    if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
+    return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
+  });
+}

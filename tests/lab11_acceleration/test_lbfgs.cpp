@@ -1,0 +1,104 @@
+// Graded tests of lab11.5: the L-BFGS two-loop recursion.
+#include <random>
+#include <stdexcept>
+#include <vector>
+
+#include <catch2/catch.hpp>
+#include <Eigen/Dense>
+
+#include "acceleration.h"
+#include "tests/support/checks.h"
+
+using cl::lab11::CurvaturePair;
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+namespace {
+
+// A random symmetric positive definite n × n matrix with eigenvalues in [1, 1 + spread].
+MatrixXd random_spd(std::mt19937_64& rng, Eigen::Index n, double spread) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  MatrixXd m(n, n);
+  for (Eigen::Index r = 0; r < n; ++r) {
+    for (Eigen::Index c = 0; c < n; ++c) m(r, c) = unit(rng);
+  }
+  const Eigen::HouseholderQR<MatrixXd> qr(m);
+  const MatrixXd q = qr.householderQ();
+  VectorXd eigenvalues(n);
+  for (Eigen::Index i = 0; i < n; ++i) eigenvalues[i] = 1.0 + spread * (0.5 + 0.5 * unit(rng));
+  return q * eigenvalues.asDiagonal() * q.transpose();
+}
+
+VectorXd random_vector(std::mt19937_64& rng, Eigen::Index n) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  VectorXd v(n);
+  for (Eigen::Index i = 0; i < n; ++i) v[i] = unit(rng);
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("the two-loop recursion equals the dense BFGS inverse update of the same pairs to 1e-10",
+          "[lab11][pts=2]") {
+  // H_(i+1) = (I − ρ_i s_i y_iᵀ) H_i (I − ρ_i y_i s_iᵀ) + ρ_i s_i s_iᵀ, ρ_i = 1/(s_iᵀ y_i),
+  // from H_0 = A⁻¹, over the pairs with s_iᵀ y_i > 0, oldest first.
+  std::mt19937_64 rng(1105);
+  for (int trial = 0; trial < 6; ++trial) {
+    const Eigen::Index n = 4 + 3 * trial;
+    const MatrixXd a = random_spd(rng, n, 10.0);
+    const MatrixXd hessian = random_spd(rng, n, 100.0);  // the "true" curvature the pairs sample
+    const Eigen::LLT<MatrixXd> a_factor(a);
+    const cl::lab11::InverseApply initial = [&](const VectorXd& v) { return VectorXd(a_factor.solve(v)); };
+    std::vector<CurvaturePair> pairs;
+    const int count = trial;  // 0 … 5 pairs
+    for (int i = 0; i < count; ++i) {
+      const VectorXd s = random_vector(rng, n);
+      pairs.push_back({s, hessian * s});
+    }
+    if (trial >= 2) {  // one pair of negative curvature, in the middle: skipped
+      const VectorXd s = random_vector(rng, n);
+      pairs.insert(pairs.begin() + 1, {s, -hessian * s});
+    }
+    MatrixXd h = a_factor.solve(MatrixXd::Identity(n, n));
+    for (const CurvaturePair& pair : pairs) {
+      const double curvature = pair.s.dot(pair.y);
+      if (!(curvature > 0.0)) continue;
+      const MatrixXd v = MatrixXd::Identity(n, n) - pair.y * pair.s.transpose() / curvature;
+      h = v.transpose() * h * v + pair.s * pair.s.transpose() / curvature;
+    }
+    const VectorXd gradient = random_vector(rng, n);
+    const VectorXd expected = -h * gradient;
+    const VectorXd direction = cl::lab11::lbfgs_direction(gradient, pairs, initial);
+    CAPTURE(trial, n, pairs.size());
+    REQUIRE(cl::test::near(direction, expected, 1e-10 * expected.cwiseAbs().maxCoeff()));
+    REQUIRE(gradient.dot(direction) < 0.0);  // a descent direction
+  }
+}
+
+TEST_CASE("without usable pairs the L-BFGS direction is minus the initial inverse times the gradient",
+          "[lab11][pts=1]") {
+  std::mt19937_64 rng(1106);
+  const Eigen::Index n = 7;
+  const MatrixXd a = random_spd(rng, n, 5.0);
+  const Eigen::LLT<MatrixXd> a_factor(a);
+  const cl::lab11::InverseApply initial = [&](const VectorXd& v) { return VectorXd(a_factor.solve(v)); };
+  const VectorXd gradient = random_vector(rng, n);
+  const VectorXd pd_direction = -a_factor.solve(gradient);
+  // No pairs: d = −A⁻¹ ∇g, projective dynamics' step (README.md).
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(gradient, {}, initial), pd_direction, 1e-15));
+  // Only pairs with sᵀy <= 0: all skipped, the same direction.
+  std::vector<CurvaturePair> bad;
+  const VectorXd s = random_vector(rng, n);
+  bad.push_back({s, -s});
+  bad.push_back({s, VectorXd::Zero(n)});  // sᵀy = 0 exactly
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(gradient, bad, initial), pd_direction, 1e-15));
+  // One good pair: the secant condition H y = s, so the direction for ∇g = y is −s.
+  const VectorXd y = a * s + random_spd(rng, n, 3.0) * s;
+  const std::vector<CurvaturePair> one{{s, y}};
+  REQUIRE(cl::test::near(cl::lab11::lbfgs_direction(y, one, initial), VectorXd(-s), 1e-12));
+  // Refused: a pair of the wrong size.
+  const std::vector<CurvaturePair> wrong{{VectorXd::Ones(n + 1), VectorXd::Ones(n + 1)}};
+  REQUIRE_THROWS_AS(cl::lab11::lbfgs_direction(gradient, wrong, initial), std::invalid_argument);
+  const std::vector<CurvaturePair> half{{VectorXd::Ones(n), VectorXd::Ones(n - 1)}};
+  REQUIRE_THROWS_AS(cl::lab11::lbfgs_direction(gradient, half, initial), std::invalid_argument);
+}
