@@ -32,8 +32,8 @@
 #
 # Drivers see CL_LAB_NAME (the lab, for summaries), CL_PROGRAM_NAME (the
 # executable, for messages) and CL_LAB_SCENE_DIR (absolute path of scenes/, an
-# expression: no absolute path is on a command line but common's own, so
-# ccache serves a copy of the tree from the first tree's compiles).
+# expression, cl::lab_scene_dir, so that the tree's path is compiled into
+# common/scene.cpp alone).
 #
 # The build writes ${PROJECT_BINARY_DIR}/labs.json, read by tools/course.py: per
 # lab its student files, whether it has a reference, its earlier labs and

@@ -55,8 +55,8 @@ def main(out_dir):
                     zorder=0, label="Pareto front")
             ax.scatter([p[0] for p in best], [p[1] for p in best], s=70, facecolors="none", edgecolors="black",
                        linewidths=1.2, zorder=5)
-            for target in (1e-2, 1e-3):
-                ax.axhline(target, color="gray", linestyle=":", linewidth=0.8)
+            for level in (1e-2, 1e-3):
+                ax.axhline(level, color="gray", linestyle=":", linewidth=0.8)
             ax.set_xlabel("wall time per step (s)")
             if column == 0:
                 ax.set_ylabel(label)
