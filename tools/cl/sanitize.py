@@ -29,8 +29,11 @@ def run_sanitized(log=sys.stdout):
 def build_sanitized(log=sys.stdout):
     """Configure (once) and build the sanitizer build's test programs; return their names."""
     configure(log=log)  # labs.json says which labs have a reference
+    # Without precompiled headers: under -fsanitize and -g1 a file that loads
+    # the header takes twice as long as one that parses its own includes
+    # (12.3 s against 5.9 s of CPU for a lab 06 test file).
     if not (SANITIZE_BUILD / "CMakeCache.txt").is_file():
-        quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), "-DCL_SANITIZE=ON",
+        quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), "-DCL_SANITIZE=ON", "-DCL_PCH=OFF",
                "-DCMAKE_BUILD_TYPE=RelWithDebInfo", "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1"],
               "configure the sanitizer build")
     targets = sanitize_targets()
