@@ -18,7 +18,7 @@ using F32 = Eigen::Matrix<double, 3, 2>;
 
 namespace {
 
-struct Case {
+struct StretchCase {
   Matrix3d corners;
   Vector3d inv_mass;
   cl::lab05::TriangleRest rest;
@@ -28,9 +28,9 @@ struct Case {
 // A random rest triangle and a random current one: any triangle is a
 // deformation of any other, with principal stretches from well below to well
 // above the bands.
-Case random_case(std::mt19937_64& rng, double scale, int index) {
+StretchCase random_stretch_case(std::mt19937_64& rng, double scale, int index) {
   const double bands[3][2] = {{0.9, 1.1}, {0.5, 2.0}, {1.0, 1.0}};
-  Case item;
+  StretchCase item;
   item.rest = cl::lab05::make_triangle_rest(lab05_test::random_triangle(rng, scale));
   item.corners = lab05_test::random_triangle(rng, scale);
   item.inv_mass = lab05_test::random_inverse_masses(rng);
@@ -39,7 +39,7 @@ Case random_case(std::mt19937_64& rng, double scale, int index) {
   return item;
 }
 
-Matrix3d limit(const Case& item) {
+Matrix3d limit_stretch_case(const StretchCase& item) {
   return cl::lab05::limit_triangle_stretch(item.corners, item.inv_mass, item.rest, item.sigma_min, item.sigma_max);
 }
 
@@ -50,13 +50,13 @@ TEST_CASE("the stretch limit puts both singular values of F in the band", "[lab0
   int moved = 0, untouched = 0;
   for (const double scale : {1e-2, 1.0, 1e2}) {
     for (int c = 0; c < 300; ++c) {
-      Case item = random_case(rng, scale, c);
+      StretchCase item = random_stretch_case(rng, scale, c);
       if (c % 7 == 6) item.corners = Eigen::AngleAxisd(1.0 + c, Vector3d(1, 2, 3).normalized()) * item.corners;
       const Vector2d before = lab05_test::singular_values(lab05_test::world_deformation(item.corners, item.rest));
       const Vector2d expected = before.cwiseMax(item.sigma_min).cwiseMin(item.sigma_max);
       CAPTURE(scale, item.corners, item.rest.shape, item.inv_mass.transpose(), item.sigma_min, item.sigma_max,
               before.transpose());
-      const Matrix3d correction = limit(item);
+      const Matrix3d correction = limit_stretch_case(item);
       const Vector2d after =
           lab05_test::singular_values(lab05_test::world_deformation(item.corners + correction, item.rest));
       CAPTURE(after.transpose(), expected.transpose());
@@ -69,7 +69,7 @@ TEST_CASE("the stretch limit puts both singular values of F in the band", "[lab0
 
   // A triangle whose F is inside the band, rigidly moved: exactly untouched.
   for (int c = 0; c < 50; ++c) {
-    Case item = random_case(rng, 1.0, 0);
+    StretchCase item = random_stretch_case(rng, 1.0, 0);
     Matrix3d rest_corners = Matrix3d::Zero();
     rest_corners.block<2, 2>(0, 1) = item.rest.shape;
     Eigen::Matrix3d stretch = Eigen::Matrix3d::Identity();
@@ -78,7 +78,7 @@ TEST_CASE("the stretch limit puts both singular values of F in the band", "[lab0
     const Eigen::Matrix3d rotation = Eigen::AngleAxisd(0.3 * c, Vector3d(3, -1, 2).normalized()).toRotationMatrix();
     item.corners = (rotation * stretch * rest_corners).colwise() + Vector3d(c, -c, 0.5);
     CAPTURE(item.corners, item.rest.shape);
-    REQUIRE(limit(item) == Matrix3d::Zero());
+    REQUIRE(limit_stretch_case(item) == Matrix3d::Zero());
     ++untouched;
   }
   REQUIRE(untouched == 50);
@@ -87,10 +87,10 @@ TEST_CASE("the stretch limit puts both singular values of F in the band", "[lab0
 TEST_CASE("the stretch limit keeps the mass-weighted centroid and the rotation of F", "[lab05][pts=1]") {
   std::mt19937_64 rng(37);
   for (int c = 0; c < 300; ++c) {
-    Case item = random_case(rng, 1.0, c);
+    StretchCase item = random_stretch_case(rng, 1.0, c);
     if (c % 5 == 4) item.inv_mass[c % 3] = 0.0;  // one pinned corner: it is the centroid
     CAPTURE(item.corners, item.rest.shape, item.inv_mass.transpose(), item.sigma_min, item.sigma_max);
-    const Matrix3d correction = limit(item);
+    const Matrix3d correction = limit_stretch_case(item);
     const Vector3d weights = lab05_test::centroid_weights(item.inv_mass);
     const double size = (item.corners.colwise() - item.corners.rowwise().mean()).norm() * weights.sum();
     REQUIRE(cl::test::near((correction * weights).norm(), 0.0, 1e-12 * size));

@@ -25,7 +25,7 @@ using Eigen::Vector3d;
 
 namespace {
 
-cl::Scene cloth(int nx, int ny) {
+cl::Scene square_cloth(int nx, int ny) {
   return cl::parse_scene(R"({"cloth": {"nx": )" + std::to_string(nx) + R"(, "ny": )" + std::to_string(ny) +
                              R"(, "pin": ["top-left", "top-right"]}})",
                          "test-cloth-" + std::to_string(nx) + "x" + std::to_string(ny));
@@ -82,7 +82,7 @@ Matrix3Xd written_pass(const cl::ClothHierarchy& hierarchy, const Matrix3Xd& sta
 // A cloth with unequal masses (0.1 … 10 times each other), pinned at the top.
 cl::Scene uneven_cloth(int nx, int ny, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> unit(0.0, 1.0);
-  cl::Scene scene = cloth(nx, ny);
+  cl::Scene scene = square_cloth(nx, ny);
   for (Eigen::Index p = 0; p < scene.particles.size(); ++p) {
     if (scene.particles.inv_mass[p] > 0.0) scene.particles.inv_mass[p] = std::pow(10.0, 2.0 * unit(rng) - 1.0);
   }
@@ -177,7 +177,7 @@ TEST_CASE("a three-level solve is the written-out pass on a cloth with unequal m
 
 TEST_CASE("with one level the solve is K Gauss-Seidel sweeps of lab 02 in file order", "[lab10][pts=1]") {
   std::mt19937_64 rng(1011);
-  const cl::Scene scene = cloth(10, 8);
+  const cl::Scene scene = square_cloth(10, 8);
   const cl::ClothHierarchy hierarchy = cl::build_cloth_hierarchy(
       10, 8, scene.particles.x, scene.particles.inv_mass, scene.springs, 1);
   std::vector<int> order(scene.springs.size());
@@ -196,7 +196,7 @@ TEST_CASE("with one level the solve is K Gauss-Seidel sweeps of lab 02 in file o
 }
 
 TEST_CASE("solve and prolongation reject bad arguments with invalid_argument", "[lab10][pts=1]") {
-  const cl::Scene scene = cloth(9, 9);
+  const cl::Scene scene = square_cloth(9, 9);
   const cl::ClothHierarchy hierarchy = cl::build_cloth_hierarchy(
       9, 9, scene.particles.x, scene.particles.inv_mass, scene.springs, 3);
   std::mt19937_64 rng(1012);
