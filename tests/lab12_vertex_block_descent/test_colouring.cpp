@@ -33,7 +33,7 @@ void require_valid(const std::vector<int>& colours, int n, const std::vector<cl:
 
 }  // namespace
 
-TEST_CASE("the greedy colouring is valid, smallest-first, deterministic, and 4 colours on a sheared grid",
+TEST_CASE("the greedy colouring is valid and smallest-first and deterministic and has 4 colours on a sheared grid",
           "[lab12][pts=2]") {
   // A chain alternates two colours; a triangle needs three.
   REQUIRE(cl::lab12::colour_particles(5, {{0, 1, 1.0, 1.0}, {1, 2, 1.0, 1.0}, {2, 3, 1.0, 1.0}, {3, 4, 1.0, 1.0}}) ==
