@@ -1,7 +1,7 @@
 #pragma once
 // Lab 12 — given code: the implicit-Euler step by vertex block descent (your
 // four functions of vbd.h, K sweeps), with the initial guesses of Chen et al.
-// (2024, §3.7: plain inertia y, or the adaptive one) and, optionally, the
+// (2024: plain inertia y, or the paper's adaptive one) and, optionally, the
 // Chebyshev acceleration of lab 11 (Wang 2015; Chen et al. §3.8) applied
 // after each sweep; and the loop over a scene's steps on common/frame_loop.h.
 // It owns the state; the functions of vbd.h stay stateless.
@@ -37,7 +37,7 @@ struct Settings {
   double rho = 0.0;        // Chebyshev: the spectral radius, [0, 1) (0: plain sweeps)
 };
 
-// The adaptive initial guess (Chen et al. 2024, eq. 6 and §3.7), per movable particle:
+// The adaptive initial guess (Chen et al. 2024; as the authors' TinyVBD), per movable particle:
 //     x⁰ = x + Δt v + Δt² ã ĝ,   ĝ = g/‖g‖,   ã = clamp(a · ĝ, 0, ‖g‖),
 // a = (v − v_previous)/Δt the acceleration of the previous step. Without a
 // previous step (has_previous false), or for ‖g‖ = 0, it is y (predict).

@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary);
   LabOptions lab;
   double rho = -1.0;
-  app.add_option("--init", lab.init, "the first iterate: inertia (y) or adaptive (Chen et al. §3.7)")
+  app.add_option("--init", lab.init, "the first iterate: inertia (y) or adaptive (Chen et al. 2024)")
       ->check(CLI::IsMember({"inertia", "adaptive"}))->capture_default_str();
   app.add_option("--tolerance", lab.settings.tolerance,
                  "stop a step once the objective's relative decrease falls below this (0: run every sweep)")

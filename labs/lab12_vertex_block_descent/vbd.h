@@ -2,7 +2,7 @@
 // Lab 12 — vertex block descent. The contract for the student's code.
 // Derivation: labs/lab12_vertex_block_descent/README.md. Source: A. H. Chen,
 // Z. Liu, Y. Yang, C. Yuksel, "Vertex Block Descent", ACM TOG 43(4)
-// (SIGGRAPH 2024), §3: the per-vertex local system, its guard, the graph
+// (SIGGRAPH 2024): the per-vertex local system, its guard, the graph
 // colouring and the parallel sweep.
 //
 // One implicit-Euler step of size Δt minimises lab 06's objective
