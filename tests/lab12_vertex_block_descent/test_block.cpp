@@ -24,6 +24,7 @@ TEST_CASE("the vertex block is lab 06's gradient block (negated) and its clamped
     const cl::lab12::Adjacency adjacency = cl::lab12::make_adjacency(9, springs);
     const Eigen::Matrix3Xd y = cl::lab06::predict(start, Eigen::Vector3d(0.0, -9.81, 0.0), dt);
     const Eigen::Matrix3Xd& x = start.x;
+    CAPTURE(trial, dt, start.x, start.v, start.inv_mass.transpose());
     const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
     const Eigen::MatrixXd hessian = Eigen::MatrixXd(cl::lab06::newton_hessian(problem, x, true));
     for (int u = 0; u < problem.map.unknowns(); ++u) {

@@ -20,6 +20,7 @@ TEST_CASE("converged VBD equals lab 06's Newton minimiser to 1e-8 on small rando
     const std::vector<cl::Spring> springs = lab12_test::random_springs(rng, start.x, 7, 0.7, 1.3, 1.0, 3.0);
     const double dt = 1.0 / 60.0;
     const cl::lab06::Problem problem = cl::lab06::make_problem(start.inv_mass, springs, dt);
+    CAPTURE(trial, start.x, start.v, start.inv_mass.transpose());
     cl::lab06::StepSettings newton_settings;
     newton_settings.iterations = 100;
     cl::Particles newton = start;
@@ -63,6 +64,8 @@ TEST_CASE("a zero-rest-length spring from a pinned point steps as lab 06's close
       particles.v.col(1) = Vector3d(unit(rng), unit(rng), unit(rng));
       particles.inv_mass.resize(2);
       particles.inv_mass << 0.0, 1.0 / mass;
+      CAPTURE(dt, cl::lab12::method_name(method), mass, k, pin.transpose(), gravity.transpose(),
+              particles.x.col(1).transpose(), particles.v.col(1).transpose());
       cl::lab12::Solver solver(particles.inv_mass, {{0, 1, 0.0, k}}, dt);
       cl::lab12::Settings settings;
       settings.gravity = gravity;
@@ -75,7 +78,7 @@ TEST_CASE("a zero-rest-length spring from a pinned point steps as lab 06's close
         v = (next - x) / dt;
         x = next;
         const cl::lab12::StepReport report = solver.step(particles, method, settings);
-        CAPTURE(dt, cl::lab12::method_name(method), mass, k, step, report.problem);
+        CAPTURE(step, report.problem);
         REQUIRE(report.problem.empty());
         const double scale = x.norm() + pin.norm() + dt * v.norm() + dt * dt * gravity.norm();
         REQUIRE(cl::test::near(particles.x.col(1), x, 1e-12 * scale));

@@ -59,6 +59,7 @@ TEST_CASE("g never increases over one vertex update with compressed springs", "[
     const cl::lab12::Adjacency adjacency = cl::lab12::make_adjacency(10, springs);
     const Eigen::Matrix3Xd y = cl::lab06::predict(start, Eigen::Vector3d(0.0, -9.81, 0.0), dt);
     Eigen::Matrix3Xd x = start.x;  // not y: the inertia term is not at its minimum either
+    CAPTURE(trial, dt, start.x, start.v, start.inv_mass.transpose());
     for (int round = 0; round < 3; ++round) {
       for (int p = 0; p < 10; ++p) {
         const double before = cl::lab06::objective(problem, x, y);
