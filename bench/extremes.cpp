@@ -299,12 +299,12 @@ int main(int argc, char** argv) {
   app.add_option("--out", options.out, "folder for the CSV files")->capture_default_str();
   app.add_option("--methods", options.methods,
                  "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles, "
-                 "pd-chebyshev, pd-lbfgs, jacobi-chebyshev")
+                 "pd-chebyshev, pd-lbfgs, jacobi-chebyshev, vbd, vbd-chebyshev")
       ->delimiter(',');
   app.add_option("--steps", options.steps, "steps per cell (default 120, quick 8)")->check(CLI::PositiveNumber);
   app.add_option("--long-steps", options.long_steps, "steps of the 10,000-iteration cells (default 12, quick 2)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--threads", options.threads, "OpenMP threads for Jacobi's sweep")
+  app.add_option("--threads", options.threads, "OpenMP threads for the Jacobi and VBD sweeps")
       ->check(CLI::Range(1, 256))
       ->capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options); });

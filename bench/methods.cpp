@@ -16,6 +16,7 @@
 #include "labs/lab09_stable_constrained/stable_step.h"
 #include "labs/lab10_hierarchical_pbd/simulation.h"
 #include "labs/lab11_acceleration/accelerated.h"
+#include "labs/lab12_vertex_block_descent/descent.h"
 
 namespace cl::bench {
 
@@ -45,6 +46,8 @@ const std::vector<MethodInfo>& all_methods() {
       {"pd-chebyshev", "lab11", Family::kImplicitEuler, true, false},
       {"pd-lbfgs", "lab11", Family::kImplicitEuler, true, false},
       {"jacobi-chebyshev", "lab11", Family::kHard, true, false},
+      {"vbd", "lab12", Family::kImplicitEuler, true, false},
+      {"vbd-chebyshev", "lab12", Family::kImplicitEuler, true, false},
   };
   return methods;
 }
@@ -266,6 +269,37 @@ class AcceleratedStepper : public Stepper {
   lab11::Settings settings_;
 };
 
+// Lab 12: vertex block descent with the adaptive initial guess, plain or with
+// Chebyshev (ρ estimated once per scene from 400 plain sweeps of its first
+// step, as the lab's driver does); the sweep runs on the program's --threads.
+class VbdStepper : public Stepper {
+ public:
+  VbdStepper(const Scene& scene, int iterations, lab12::Method method)
+      : solver_(scene.particles.inv_mass, scene.springs, scene.dt), method_(method) {
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+    if (method == lab12::Method::kVbdChebyshev) {
+      const std::string key = scene.name + "/" + std::to_string(scene.particles.size()) + "/" + std::to_string(scene.dt);
+      static std::map<std::string, double> estimates;  // the trade builds a stepper per K
+      auto found = estimates.find(key);
+      if (found == estimates.end()) {
+        const double rho = solver_.estimate_rho(scene.particles, settings_, 400);
+        found = estimates.emplace(key, rho < 1.0 ? rho : 0.0).first;
+      }
+      settings_.rho = found->second;
+    }
+  }
+  StepOutcome step(Particles& particles) override {
+    const lab12::StepReport report = solver_.step(particles, method_, settings_);
+    return {report.problem, report.iterations_done};
+  }
+
+ private:
+  lab12::Solver solver_;
+  lab12::Method method_;
+  lab12::Settings settings_;
+};
+
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations) {
@@ -282,6 +316,8 @@ std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& sc
   if (name == "limit-springs") return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kSprings);
   if (name == "pd-chebyshev") return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kPdChebyshev);
   if (name == "pd-lbfgs") return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kPdLbfgs);
+  if (name == "vbd") return std::make_unique<VbdStepper>(scene, iterations, lab12::Method::kVbd);
+  if (name == "vbd-chebyshev") return std::make_unique<VbdStepper>(scene, iterations, lab12::Method::kVbdChebyshev);
   if (name == "jacobi-chebyshev") {
     return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kJacobiChebyshev);
   }

@@ -35,7 +35,7 @@ struct MethodInfo {
 
 // Every method, in the order of the tables: gs-pbd, jacobi-pbd, hpbd, xpbd,
 // pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles,
-// pd-chebyshev, pd-lbfgs, jacobi-chebyshev (lab 11).
+// pd-chebyshev, pd-lbfgs, jacobi-chebyshev (lab 11), vbd, vbd-chebyshev (lab 12).
 const std::vector<MethodInfo>& all_methods();
 // Throws std::invalid_argument for an unknown name (the message lists them).
 const MethodInfo& method_info(const std::string& name);

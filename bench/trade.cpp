@@ -51,14 +51,15 @@ struct Options {
   int horizon = 0;        // 0: 20 (quick 10)
   int warmup = 0;         // 0: 10 (quick 5)
   double step_cap = 0.0;  // 0: 0.3 s (quick 0.05 s)
-  int threads = 1;        // OpenMP threads (Jacobi's sweep)
+  int threads = 1;        // OpenMP threads (the Jacobi and VBD sweeps)
 };
 
 // The methods the trade compares (lab 05's limiter solves a different
 // problem again, explicit springs held in a band: only the extremes run it).
 const std::vector<std::string> kTradeMethods{"gs-pbd", "jacobi-pbd", "hpbd", "xpbd", "pd",
                                              "newton", "kkt",        "schur", "schur-kg",
-                                             "pd-chebyshev", "pd-lbfgs", "jacobi-chebyshev"};
+                                             "pd-chebyshev", "pd-lbfgs", "jacobi-chebyshev", "vbd",
+                                             "vbd-chebyshev"};
 const std::vector<std::string> kAllScenes{"rope-100", "curtain-16", "curtain-32", "curtain-64", "curtain-128"};
 const std::vector<std::string> kQuickScenes{"rope-100", "curtain-16", "curtain-32"};
 
@@ -520,7 +521,8 @@ int main(int argc, char** argv) {
   app.add_option("--scenes", options.scenes, "rope-100, curtain-N (default: rope-100 and curtains 16 to 128)")
       ->delimiter(',');
   app.add_option("--methods", options.methods,
-                 "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, pd-chebyshev, pd-lbfgs, jacobi-chebyshev")
+                 "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, pd-chebyshev, pd-lbfgs, jacobi-chebyshev, "
+                 "vbd, vbd-chebyshev")
       ->delimiter(',');
   app.add_option("--stiffness", options.stiffness, "every spring's stiffness, N/m")
       ->check(cl::finite_number(false))

@@ -1,0 +1,325 @@
+// Lab 12 — given code: the VBD step, its initial guesses, Chebyshev on top, and the run.
+#include "descent.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "acceleration.h"
+#include "common/health.h"
+#include "common/metrics.h"
+#include "common/timer.h"
+
+namespace cl::lab12 {
+
+namespace {
+
+// lab 06's tolerance rule: the relative decrease fell below tol.
+bool decrease_below(double previous, double current, double tolerance) {
+  if (!(previous > 0.0)) return true;
+  return previous - current < tolerance * previous;
+}
+
+void check(const Settings& settings) {
+  if (settings.iterations < 0) throw std::invalid_argument("iterations must be >= 0");
+  if (!std::isfinite(settings.tolerance) || settings.tolerance < 0.0) {
+    throw std::invalid_argument("tolerance must be finite and >= 0");
+  }
+  if (!std::isfinite(settings.rho) || settings.rho < 0.0 || settings.rho >= 1.0) {
+    throw std::invalid_argument("rho must be in [0, 1) (got " + std::to_string(settings.rho) + ")");
+  }
+  if (!settings.gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
+}
+
+// Wall time of the method, without what is spent only for the records.
+struct Clock {
+  Timer timer;
+  double excluded = 0.0;
+  double seconds() const { return timer.seconds() - excluded; }
+};
+
+// The relative slack of lab 11's restart rule.
+constexpr double kRestartSlack = 1e-13;
+
+}  // namespace
+
+const char* method_name(Method method) { return method == Method::kVbdChebyshev ? "vbd-chebyshev" : "vbd"; }
+
+Method method_from_name(const std::string& name) {
+  if (name == "vbd") return Method::kVbd;
+  if (name == "vbd-chebyshev") return Method::kVbdChebyshev;
+  throw std::invalid_argument("unknown method '" + name + "' (vbd or vbd-chebyshev)");
+}
+
+const char* init_name(Init init) { return init == Init::kAdaptive ? "adaptive" : "inertia"; }
+
+Init init_from_name(const std::string& name) {
+  if (name == "inertia") return Init::kInertia;
+  if (name == "adaptive") return Init::kAdaptive;
+  throw std::invalid_argument("unknown initial guess '" + name + "' (inertia or adaptive)");
+}
+
+Adjacency make_adjacency(int particles, const std::vector<Spring>& springs) {
+  if (particles < 0) throw std::invalid_argument("make_adjacency: a negative number of particles");
+  Adjacency adjacency;
+  adjacency.offsets.assign(static_cast<std::size_t>(particles) + 1, 0);
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    if (s.i < 0 || s.j < 0 || s.i >= particles || s.j >= particles) {
+      throw std::invalid_argument("make_adjacency: springs[" + std::to_string(e) + "] has an end outside [0, " +
+                                  std::to_string(particles) + ")");
+    }
+    ++adjacency.offsets[static_cast<std::size_t>(s.i) + 1];
+    if (s.j != s.i) ++adjacency.offsets[static_cast<std::size_t>(s.j) + 1];
+  }
+  for (std::size_t p = 0; p < static_cast<std::size_t>(particles); ++p) adjacency.offsets[p + 1] += adjacency.offsets[p];
+  adjacency.springs.assign(static_cast<std::size_t>(adjacency.offsets.back()), -1);
+  std::vector<int> fill(adjacency.offsets.begin(), adjacency.offsets.end() - 1);
+  for (std::size_t e = 0; e < springs.size(); ++e) {  // increasing e: each list is sorted
+    const Spring& s = springs[e];
+    adjacency.springs[static_cast<std::size_t>(fill[static_cast<std::size_t>(s.i)]++)] = static_cast<int>(e);
+    if (s.j != s.i) adjacency.springs[static_cast<std::size_t>(fill[static_cast<std::size_t>(s.j)]++)] = static_cast<int>(e);
+  }
+  return adjacency;
+}
+
+std::vector<std::vector<int>> colour_groups(const std::vector<int>& colours, const Eigen::VectorXd& inv_mass) {
+  if (static_cast<Eigen::Index>(colours.size()) != inv_mass.size()) {
+    throw std::invalid_argument("colour_groups: one colour per particle needed");
+  }
+  int count = 0;
+  for (const int c : colours) {
+    if (c < 0) throw std::invalid_argument("colour_groups: a negative colour");
+    count = std::max(count, c + 1);
+  }
+  std::vector<std::vector<int>> groups(static_cast<std::size_t>(count));
+  for (std::size_t p = 0; p < colours.size(); ++p) {
+    if (inv_mass[static_cast<Eigen::Index>(p)] > 0.0) groups[static_cast<std::size_t>(colours[p])].push_back(static_cast<int>(p));
+  }
+  groups.erase(std::remove_if(groups.begin(), groups.end(), [](const std::vector<int>& g) { return g.empty(); }),
+               groups.end());
+  return groups;
+}
+
+Eigen::Matrix3Xd adaptive_guess(const Particles& particles, const Eigen::Matrix3Xd& previous_velocity,
+                                bool has_previous, const Eigen::Vector3d& gravity, double dt) {
+  const double g = gravity.norm();
+  if (!has_previous || !(g > 0.0)) return lab06::predict(particles, gravity, dt);
+  if (previous_velocity.cols() != particles.size()) {
+    throw std::invalid_argument("adaptive_guess: previous_velocity needs one column per particle");
+  }
+  const Eigen::Vector3d down = gravity / g;
+  Eigen::Matrix3Xd x = particles.x;
+  for (Eigen::Index p = 0; p < particles.size(); ++p) {
+    if (!(particles.inv_mass[p] > 0.0)) continue;
+    const double along = ((particles.v.col(p) - previous_velocity.col(p)) / dt).dot(down);
+    const double a = std::clamp(std::isfinite(along) ? along : 0.0, 0.0, g);
+    x.col(p) += dt * particles.v.col(p) + (dt * dt * a) * down;
+  }
+  return x;
+}
+
+// ------------------------------------------------------------------ the solver
+
+Solver::Solver(const Eigen::VectorXd& inv_mass, const std::vector<Spring>& springs, double dt)
+    : problem_(lab06::make_problem(inv_mass, springs, dt)) {
+  const int n = static_cast<int>(inv_mass.size());
+  adjacency_ = make_adjacency(n, problem_.springs);
+  colours_ = colour_particles(n, problem_.springs);
+  if (static_cast<int>(colours_.size()) != n) throw std::logic_error("colour_particles: not one colour per particle");
+  groups_ = colour_groups(colours_, problem_.inv_mass);
+}
+
+int Solver::colour_count() const {
+  int count = 0;
+  for (const int c : colours_) count = std::max(count, c + 1);
+  return count;
+}
+
+StepReport Solver::step(Particles& particles, Method method, const Settings& settings,
+                        const IterationCallback& on_iteration) {
+  check(settings);
+  if (particles.size() != problem_.inv_mass.size() || particles.v.cols() != particles.size()) {
+    throw std::invalid_argument("Solver::step: the particles do not match the solver's scene");
+  }
+  const Timer timer;
+  const double dt = problem_.dt;
+  const Eigen::Matrix3Xd y = lab06::predict(particles, settings.gravity, dt);
+  Eigen::Matrix3Xd x = settings.init == Init::kAdaptive
+                           ? adaptive_guess(particles, previous_velocity_, has_previous_, settings.gravity, dt)
+                           : y;
+  StepReport report = minimise(x, y, method, settings, on_iteration);
+  if (report.problem.empty() && !all_finite(x)) report.problem = std::string(method_name(method)) + ": non-finite positions";
+  if (report.problem.empty()) {
+    previous_velocity_ = particles.v;
+    has_previous_ = true;
+    for (Eigen::Index p = 0; p < particles.size(); ++p) {
+      particles.v.col(p) = problem_.inv_mass[p] > 0.0 ? Eigen::Vector3d((x.col(p) - particles.x.col(p)) / dt)
+                                                      : Eigen::Vector3d::Zero();
+    }
+    particles.x = x;
+  }
+  report.seconds = timer.seconds();
+  return report;
+}
+
+StepReport Solver::minimise(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Method method, const Settings& settings,
+                            const IterationCallback& on_iteration) const {
+  check(settings);
+  const Eigen::Index n = problem_.inv_mass.size();
+  if (x.cols() != n || y.cols() != n) throw std::invalid_argument("Solver::minimise: x and y need one column per particle");
+  const bool accelerated = method == Method::kVbdChebyshev && settings.rho > 0.0;
+  const bool tracked = accelerated || settings.tolerance > 0.0 || on_iteration;
+  StepReport report;
+  Clock clock;
+  auto record = [&](const IterationRecord& values) {
+    if (!on_iteration) return false;
+    const Timer timer;
+    IterationRecord copy = values;
+    copy.seconds = clock.seconds();
+    const bool stop = on_iteration(copy);
+    clock.excluded += timer.seconds();
+    return stop;
+  };
+  double g = std::numeric_limits<double>::quiet_NaN();
+  bool stopped = false;
+  if (tracked) {
+    const Timer timer;
+    g = lab06::objective(problem_, x, y);
+    if (!accelerated && settings.tolerance == 0.0) clock.excluded += timer.seconds();
+    stopped = record({0, g, 1.0, false, 0.0});
+  }
+  int count = 0;  // Chebyshev: j of this iteration since the start or the last restart
+  double omega = 1.0;
+  Eigen::Matrix3Xd previous = x, plain;
+  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+    plain = x;
+    vbd_sweep(problem_, adjacency_, groups_, y, plain);
+    IterationRecord values{k, 0.0, 1.0, false, 0.0};
+    double value = std::numeric_limits<double>::quiet_NaN();
+    if (accelerated) {
+      ++count;
+      omega = lab11::chebyshev_weight(count, settings.rho, omega);
+      values.omega = omega;
+      Eigen::Matrix3Xd next = plain;
+      if (omega != 1.0) {
+        next = lab11::chebyshev_update(plain, x, previous, omega, 1.0);
+        for (Eigen::Index p = 0; p < n; ++p) {
+          if (!(problem_.inv_mass[p] > 0.0)) next.col(p) = y.col(p);
+        }
+      }
+      value = lab06::objective(problem_, next, y);
+      if (omega != 1.0 && lab11::restart_needed(g, value, kRestartSlack)) {
+        next = plain;
+        value = lab06::objective(problem_, next, y);
+        values.restarted = true;
+        values.omega = 1.0;
+        ++report.restarts;
+        count = 1;
+        omega = 1.0;
+      }
+      previous.swap(x);
+      x.swap(next);
+    } else {
+      x.swap(plain);
+      if (tracked) {
+        const Timer timer;
+        value = lab06::objective(problem_, x, y);
+        if (settings.tolerance == 0.0) clock.excluded += timer.seconds();
+      }
+    }
+    report.iterations_done = k;
+    if (!all_finite(x)) {
+      report.problem = std::string(method_name(method)) + ": non-finite positions after sweep " + std::to_string(k);
+      return report;
+    }
+    if (!tracked) continue;
+    values.objective = value;
+    stopped = record(values);
+    const bool small = settings.tolerance > 0.0 && decrease_below(g, value, settings.tolerance);
+    g = value;
+    if (small) {
+      report.converged = true;
+      break;
+    }
+  }
+  report.objective = std::isnan(g) ? lab06::objective(problem_, x, y) : g;
+  return report;
+}
+
+double Solver::estimate_rho(const Particles& start, const Settings& settings, int iterations) const {
+  if (iterations < 2) throw std::invalid_argument("estimate_rho: needs at least 2 iterations");
+  const double scale = std::max(start.x.cwiseAbs().maxCoeff(), 1e-300);
+  const Eigen::Matrix3Xd y = lab06::predict(start, settings.gravity, problem_.dt);
+  Eigen::Matrix3Xd x = y, next;
+  std::vector<double> norms;
+  for (int k = 0; k < iterations; ++k) {
+    next = x;
+    vbd_sweep(problem_, adjacency_, groups_, y, next);
+    const double length = (next - x).norm();
+    if (!std::isfinite(length) || length <= 1e-12 * scale) break;  // round-off: no rate left to measure
+    norms.push_back(length);
+    x.swap(next);
+  }
+  if (norms.size() < 2) return 0.0;
+  return lab11::estimate_spectral_radius(norms);
+}
+
+// ------------------------------------------------------------------ a run
+
+RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
+                    const StepCallback& on_step, const RunIterationCallback& on_iteration, const FrameOutput& output) {
+  if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
+  const lab06::Problem& problem = solver.problem();
+  RunResult result;
+  StepRecord record;
+  StepReport report;
+  auto total_energy = [&] {
+    return kinetic_energy(particles) + potential_energy(particles, settings.gravity) +
+           lab06::spring_energy(particles.x, problem.springs);
+  };
+  auto step = [&](int s) {
+    IterationCallback each = nullptr;
+    if (on_iteration) {
+      each = [&](const IterationRecord& iteration) {
+        on_iteration(s, iteration);
+        return false;
+      };
+    }
+    report = solver.step(particles, method, settings, each);
+    result.iterations_done += report.iterations_done;
+    result.restarts += report.restarts;
+    return StepVerdict{report.problem, true, report.seconds};
+  };
+  auto measured = [&](int s, double) {
+    record = StepRecord{};
+    record.step = s;
+    if (s > 0) record.report = report;
+    record.strain = strain_stats(particles.x, problem.springs);
+    record.total_energy = total_energy();
+    return FrameMeasure{record.strain, record.total_energy, {},
+                        {record.report.objective, static_cast<long long>(record.report.iterations_done),
+                         static_cast<long long>(record.report.converged ? 1 : 0),
+                         static_cast<long long>(record.report.restarts), record.report.seconds, record.strain.max,
+                         record.strain.rms, record.total_energy},
+                        {}};
+  };
+  const double scale = energy_scale(particles, settings.gravity, problem.dt) +
+                       lab06::spring_energy(particles.x, problem.springs);
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, frame_plan(steps, problem.dt, scale), with_index,
+                                             record_hook(record, on_step));
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"objective", "iterations", "converged", "restarts", "seconds", "max_strain", "rms_strain", "total_energy"};
+}
+
+}  // namespace cl::lab12
