@@ -29,6 +29,7 @@ class FrameWriter {
       if (output.scene == nullptr) throw std::invalid_argument("run_frame_loop: a trajectory needs FrameOutput::scene");
       TrajectoryIdentity identity{output.lab, output.method, plan.energy_name, "s"};
       trajectory_.emplace(output.trajectory_dir, output.trajectory_every, *output.scene, identity);
+      trajectory_->reserve(trajectory_frames_kept(plan.frames, output.trajectory_every) + 1);
     }
   }
 

@@ -87,6 +87,13 @@ TrajectoryWriter::TrajectoryWriter(const std::string& dir, int every, const Scen
   if (every < 1) throw std::invalid_argument("TrajectoryWriter: every must be >= 1 (got " + std::to_string(every) + ")");
 }
 
+void TrajectoryWriter::reserve(int frames) {
+  if (frames <= 0) return;
+  const std::size_t frame = trajectory_frame_bytes(static_cast<std::size_t>(scene_.particles.size()), scene_.springs.size());
+  data_.reserve(std::min(kTrajectoryCapBytes, frame * static_cast<std::size_t>(frames)));
+  records_.reserve(static_cast<std::size_t>(frames));
+}
+
 void TrajectoryWriter::add(int frame, double time, const Eigen::Matrix3Xd& x, double energy,
                            const std::string& status) {
   if (!x.allFinite()) {
@@ -110,19 +117,24 @@ void TrajectoryWriter::add(int frame, double time, const Eigen::Matrix3Xd& x, do
   const std::size_t start = data_.size();
   data_.resize(start + trajectory_frame_bytes(n, springs), 0);
   std::uint8_t* out = data_.data() + start;
+  // Rounding to the nearest level as + 0.5 and truncation (the levels are >= 0):
+  // std::round was a third of the writer's time.
+  Eigen::Vector3d per_level = Eigen::Vector3d::Zero();
+  for (int axis = 0; axis < 3; ++axis) {
+    if (record.step[axis] > 0.0) per_level[axis] = 1.0 / record.step[axis];
+  }
   for (std::size_t p = 0; p < n; ++p) {
     for (int axis = 0; axis < 3; ++axis) {
-      const double step = record.step[axis];
-      const double level = step > 0.0 ? std::round((x(axis, static_cast<Eigen::Index>(p)) - record.box_min[axis]) / step) : 0.0;
+      const double level = (x(axis, static_cast<Eigen::Index>(p)) - record.box_min[axis]) * per_level[axis] + 0.5;
       const auto q = static_cast<std::uint16_t>(std::clamp(level, 0.0, 65535.0));
       *out++ = static_cast<std::uint8_t>(q & 0xffu);  // little-endian
       *out++ = static_cast<std::uint8_t>(q >> 8);
     }
   }
+  const double per_strain = record.strain_scale > 0.0 ? 127.0 / record.strain_scale : 0.0;
   for (std::size_t e = 0; e < springs; ++e) {
-    const double level = record.strain_scale > 0.0 ? std::round(127.0 * strain[e] / record.strain_scale) : 0.0;
-    const auto q = static_cast<std::int8_t>(std::clamp(level, -127.0, 127.0));
-    *out++ = static_cast<std::uint8_t>(q);
+    const double level = std::clamp(strain[e] * per_strain, -127.0, 127.0) + 127.5;  // 0.5 … 254.5
+    *out++ = static_cast<std::uint8_t>(static_cast<std::int8_t>(static_cast<int>(level) - 127));
   }
   records_.push_back(std::move(record));
 }

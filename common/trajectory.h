@@ -60,6 +60,9 @@ class TrajectoryWriter {
   // True when frame `frame` is one to keep (a multiple of every).
   bool due(int frame) const { return frame % every_ == 0; }
 
+  // Room for `frames` frames (a hint: fewer or more may come).
+  void reserve(int frames);
+
   // Keeps this frame (positions x, m, in scene order; energy J, NaN: unknown;
   // status "ok" or the frame's problem). A frame with a non-finite position is
   // not kept: it is the header's "stopped" record (frame and status).
