@@ -29,8 +29,8 @@ void print_time(double seconds, int steps, const char* step, double work, const 
 
 void print_trajectory_note(const CommonOptions& options, const char* frame) {
   if (options.frames <= 0) return;
-  std::printf("  trajectory: %s/trajectory.{json,bin}, %s 0, %d, 2·%d, ... (./course view %s)\n", options.out.c_str(), frame,
-              options.frames, options.frames, options.out.c_str());
+  std::printf("  trajectory: %s/trajectory.{json,bin}, %s 0, %d, %d, ... and the last (./course view %s)\n",
+              options.out.c_str(), frame, options.frames, 2 * options.frames, options.out.c_str());
 }
 
 }  // namespace cl

@@ -84,12 +84,15 @@ double signed_strain(const Eigen::Matrix3Xd& x, const Spring& spring) {
 
 TrajectoryWriter::TrajectoryWriter(const std::string& dir, int every, const Scene& scene, TrajectoryIdentity identity)
     : dir_(dir), every_(every), scene_(scene), identity_(std::move(identity)) {
-  if (every < 1) throw std::invalid_argument("TrajectoryWriter: every must be >= 1 (got " + std::to_string(every) + ")");
+  if (every < 1) {
+    throw std::invalid_argument("TrajectoryWriter: every must be >= 1 (got " + std::to_string(every) + ")");
+  }
 }
 
 void TrajectoryWriter::reserve(int frames) {
   if (frames <= 0) return;
-  const std::size_t frame = trajectory_frame_bytes(static_cast<std::size_t>(scene_.particles.size()), scene_.springs.size());
+  const std::size_t frame =
+      trajectory_frame_bytes(static_cast<std::size_t>(scene_.particles.size()), scene_.springs.size());
   data_.reserve(std::min(kTrajectoryCapBytes, frame * static_cast<std::size_t>(frames)));
   records_.reserve(static_cast<std::size_t>(frames));
 }

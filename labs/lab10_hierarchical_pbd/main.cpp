@@ -284,7 +284,8 @@ int main(int argc, char** argv) {
   cl::CommonOptions options;
   options.scene = "flat-curtain-64";
   cl::add_common_options(app, options,
-                         cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
+                         cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary |
+                             cl::kFlagFrames);
   app.get_option("--frames")
       ->description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
                     "mesh into OUT/frames/");

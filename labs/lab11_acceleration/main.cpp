@@ -209,7 +209,9 @@ int main(int argc, char** argv) {
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
-    if (lab.convergence && options.frames > 0) throw cl::InputError("--frames: only for a run of steps (not with --convergence)");
+    if (lab.convergence && options.frames > 0) {
+      throw cl::InputError("--frames: only for a run of steps (not with --convergence)");
+    }
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
 }
