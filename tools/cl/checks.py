@@ -333,13 +333,9 @@ def view_refusal_problems(scratch):
 
 
 def check_browser(checks):
-    """The view in a real browser (headless Chromium, software WebGL): a short
-    lab 04 run, a two-run comparison and two runs of different particle counts."""
-    chromium = shutil.which("chromium")
-    if not chromium:
-        print("skip  the view in a browser: chromium is not installed (./course installs Debian's chromium "
-              "when run as root; or: sudo apt-get install chromium)")
-        return
+    """./course view's refusals, then the view in a real browser (headless
+    Chromium, software WebGL): a short lab 04 run, a two-run comparison and two
+    runs of different particle counts."""
     program = BIN / "lab04_pbd_solution"
     scratch = BUILD / "test-view"
     shutil.rmtree(scratch, ignore_errors=True)
@@ -358,6 +354,11 @@ def check_browser(checks):
     problems = view_refusal_problems(scratch)
     checks.record(not problems, "./course view refuses a folder without a trajectory, a truncated and a corrupt "
                   "one (exit 2, one line, nothing written)", problems)
+    chromium = shutil.which("chromium")
+    if not chromium:
+        print("skip  the view in a browser: chromium is not installed (./course installs Debian's chromium "
+              "when run as root; or: sudo apt-get install chromium)")
+        return
 
     run_a = load_run(scratch / "a")
     last = run_a[0]["frame_count"] - 1

@@ -148,10 +148,12 @@
       [0, Math.floor(n / 2), n - 1].forEach(function (p) {
         if (p >= 0) samples.push([r, p, d.x[3 * p], d.x[3 * p + 1], d.x[3 * p + 2]]);
       });
-      var unit = h.time_unit === 's' ? ' s' : ' ' + h.time_unit + '(s)';
+      // A sweep lab's frame is its sweep: no time of its own to show.
+      var seconds = h.time_unit === 's';
+      var when = seconds ? ' · t = ' + fmt(f.time) + ' s' : '';
       var status = f.status && f.status !== 'ok' ? '  ' + f.status : '';
       hud.push('<div class="run"><b>' + esc(h.lab) + '</b> · ' + esc(h.scene) + ' · ' + esc(h.method) +
-               '\nframe ' + f.frame + ' (' + (k + 1) + '/' + h.frames.length + ') · t = ' + fmt(f.time) + unit +
+               '\n' + (seconds ? 'frame ' : h.time_unit + ' ') + f.frame + ' (' + (k + 1) + '/' + h.frames.length + ')' + when +
                ' · max strain ' + fmt(f.max_strain, 3) +
                (h.energy_name ? ' · ' + esc(h.energy_name) + ' ' + fmt(f.energy, 6) + ' J' : '') + esc(status) +
                (h.stopped && k === h.frames.length - 1 ? '\nstopped at frame ' + h.stopped.frame + ': ' + esc(h.stopped.status) : '') +
