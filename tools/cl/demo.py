@@ -78,8 +78,13 @@ def write_views(out, labs=None, echo=True):
     return written
 
 
+def _href(path, out):
+    """A link from out/index.html to `path`."""
+    return html.escape(os.path.relpath(path, out).replace(os.sep, "/"), quote=True)
+
+
 def index_page(out):
-    """out/index.html's text: per lab, its figures (thumbnails) and its views."""
+    """out/index.html's text: per lab, its views, its figures (thumbnails) and its handout."""
     sections = []
     for lab in lab_dirs():
         lab_out = out / lab
@@ -89,16 +94,15 @@ def index_page(out):
         views = sorted(p for p in lab_out.rglob("*.html") if p.name == "view.html" or p.name.startswith("view-"))
         if not figures and not views:
             continue
-        def link(path):
-            return html.escape(path.relative_to(out).as_posix(), quote=True)
-        items = [f'<li><a href="{link(v)}">{html.escape(v.relative_to(lab_out).as_posix())}</a></li>' for v in views]
-        thumbs = [f'<a href="{link(f)}" title="{link(f)}"><img src="{link(f)}" alt="{link(f)}" loading="lazy"></a>'
-                  for f in figures]
+        items = "".join(f'<li><a href="{_href(v, out)}">{html.escape(v.relative_to(lab_out).as_posix())}</a></li>'
+                        for v in views)
+        thumbs = "".join(f'<a href="{_href(f, out)}" title="{_href(f, out)}"><img src="{_href(f, out)}" '
+                         f'alt="{_href(f, out)}" loading="lazy"></a>' for f in figures)
         readme = ROOT / "labs" / lab / "README.md"
-        handout = f' · <a href="{html.escape(os.path.relpath(readme, out), quote=True)}">handout</a>' if readme.is_file() else ""
+        handout = f' · <a href="{_href(readme, out)}">handout</a>' if readme.is_file() else ""
         sections.append(f'<section id="{lab}"><h2>{lab}{handout}</h2>'
-                        + (f'<h3>views (open, then play, orbit, compare)</h3><ul>{"".join(items)}</ul>' if items else "")
-                        + (f'<h3>figures</h3><div class="thumbs">{"".join(thumbs)}</div>' if thumbs else "")
+                        + (f"<h3>views (open, then play, orbit, compare)</h3><ul>{items}</ul>" if items else "")
+                        + (f'<h3>figures</h3><div class="thumbs">{thumbs}</div>' if thumbs else "")
                         + "</section>")
     contents = "".join(f'<a href="#{lab}">{lab[:5]}</a> ' for lab in lab_dirs() if (out / lab).is_dir())
     return f"""<!DOCTYPE html>
