@@ -265,18 +265,31 @@ def open_in_chromium(chromium, page, frame, screenshot):
     return attrs, problems
 
 
+VIEW_BACKGROUND = (0xf4, 0xf4, 0xf0)  # the page's and the renderer's clear colour (view.py, view_player.js)
+
+
 def screenshot_shares(first, second):
-    """(share of non-background pixels of FIRST, of SECOND, share of pixels that differ)."""
+    """(share of non-background pixels of FIRST, of SECOND, share of pixels that
+    differ), over the part of the 800 × 600 screenshots where the runs are drawn."""
     from PIL import Image, ImageChops
 
+    # The drawing alone: below the heads-up lines, above the controls, left of the colour bar.
     images = [Image.open(path).convert("RGB") for path in (first, second)]
-    background = images[0].getpixel((images[0].width // 2, 2))  # above the picture, below nothing but the page
+    images = [image.crop((0, 110, image.width - 180, image.height - 60)) for image in images]
+    background = VIEW_BACKGROUND
     shares = []
     for image in images:
         flat = ImageChops.difference(image, Image.new("RGB", image.size, background)).convert("L")
         shares.append(sum(flat.point(lambda v: 255 if v > 12 else 0).histogram()[255:]) / (image.width * image.height))
     changed = ImageChops.difference(*images).convert("L").point(lambda v: 255 if v > 12 else 0)
     return shares[0], shares[1], changed.histogram()[255] / (images[0].width * images[0].height)
+
+
+def drawn(share):
+    """A screenshot's share of non-background pixels, as a drawn view has it:
+    some mesh (>= 1 %), and the renderer's cleared background around it (a
+    canvas never drawn is black: 100 %)."""
+    return 0.01 <= share <= 0.95
 
 
 def sample_problems(attrs, runs, frames, truth=None):
@@ -378,9 +391,9 @@ def check_browser(checks):
         shots.append(shot)
     if all(shot.is_file() for shot in shots):
         first, second, changed = screenshot_shares(*shots)
-        if min(first, second) < 0.01:
+        if not all(drawn(share) for share in (first, second)):
             problems.append(f"a screenshot is blank: {100 * first:.2f} % and {100 * second:.2f} % of its pixels "
-                            "are not background")
+                            "are not background (a drawn view has some, and a cleared background around them)")
         if changed < 0.001:
             problems.append(f"the first and the last frame look the same ({100 * changed:.3f} % of pixels differ)")
     else:
@@ -405,7 +418,7 @@ def check_browser(checks):
             problems += sample_problems(attrs, runs_shown, [last, last])
         if shot.is_file():
             share = screenshot_shares(shot, shot)[0]
-            if share < 0.01:
+            if not drawn(share):
                 problems.append(f"{'+'.join(names)}: the screenshot is blank ({100 * share:.2f} %)")
     checks.record(not problems, "side-by-side views in headless Chromium: K = 1 against K = 16 (one clock), "
                   "and a curtain beside a rope (different particle counts)", problems)
