@@ -231,7 +231,8 @@ def check_views(checks, out, labs):
         return
     index = write_index(out)
     missing = index_links(out)
-    checks.record(not missing and bool(views),
+    # A student release of an early week has no reference that keeps a trajectory.
+    checks.record(not missing and (bool(views) or is_release()),
                   f"{show(index)}: {len(views)} views, every link resolves" if not missing
                   else f"{show(index)}: {len(missing)} links do not resolve", missing[:5])
 
