@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common/not_implemented.h"
+#include "common/trajectory.h"
 
 namespace cl {
 
@@ -67,12 +68,23 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
   }
   if (flags & kFlagOut) app.add_option("--out", options.out, "directory for the CSV files");
   if (flags & kFlagSummary) app.add_option("--summary", options.summary, "write the run summary (JSON) here");
+  if (flags & kFlagFrames) {
+    app.add_option("--frames", options.frames,
+                   options.frames_are_sweeps
+                       ? "keep every N-th sweep in OUT/trajectory.json and .bin (./course view OUT)"
+                       : "keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT)")
+        ->check(CLI::Range(1, 100'000'000));
+  }
 }
 
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir) {
   Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir));
   if (options.dt > 0.0) scene.dt = options.dt;
   if (options.steps >= 0) scene.steps = options.steps;
+  if (options.frames > 0) {
+    if (options.out.empty()) throw InputError("--frames: needs --out DIR (the trajectory goes to OUT/trajectory.*)");
+    check_trajectory_size(scene, options.frames_are_sweeps ? options.iterations : scene.steps, options.frames);
+  }
   return scene;
 }
 
@@ -101,6 +113,9 @@ int noting(int code, const std::string& program, const char* student_earlier_lab
 int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
              const char* student_earlier_labs) {
   const std::string program = app.get_name();
+  std::vector<const char*> words(argv, argv + argc);
+  if (!words.empty()) words[0] = program.c_str();
+  set_command_line(argc, words.data());
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {

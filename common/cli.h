@@ -33,6 +33,7 @@ enum CommonFlag : unsigned {
   kFlagSteps = 1u << 4,       // --steps N
   kFlagOut = 1u << 5,         // --out DIR
   kFlagSummary = 1u << 6,     // --summary FILE.json
+  kFlagFrames = 1u << 7,      // --frames N: the trajectory (common/trajectory.h)
 };
 
 struct CommonOptions {
@@ -44,6 +45,10 @@ struct CommonOptions {
   int steps = -1;                    // -1: the scene's
   std::string out;                   // empty: no CSV files
   std::string summary;               // empty: no summary file
+  int frames = 0;                    // keep every N-th frame in OUT/trajectory.*; 0: none
+  // A sweep lab (02, 03) keeps one frame per sweep: its last frame is
+  // --iterations, not the scene's steps (the trajectory's size check).
+  bool frames_are_sweeps = false;
 };
 
 // A CLI11 check: a finite number > 0 (or >= 0 with allow_zero). Unlike CLI11's
@@ -58,7 +63,9 @@ CLI::Validator finite_in(double low, double high);
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 
 // Loads the scene named by --scene for a lab whose scenes live in
-// lab_scene_dir, and applies --dt and --steps. Throws InputError.
+// lab_scene_dir, and applies --dt and --steps. With --frames N it also refuses
+// a run without --out and one whose trajectory would be over the size cap
+// (check_trajectory_size), before anything is written. Throws InputError.
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir);
 
 

@@ -27,4 +27,10 @@ void print_time(double seconds, int steps, const char* step, double work, const 
   if (work > 0) std::printf(", %.3e s per %s", seconds / work, work_unit);
 }
 
+void print_trajectory_note(const CommonOptions& options, const char* frame) {
+  if (options.frames <= 0) return;
+  std::printf("  trajectory: %s/trajectory.{json,bin}, %s 0, %d, %d, ... and the last (./course view %s)\n",
+              options.out.c_str(), frame, options.frames, 2 * options.frames, options.out.c_str());
+}
+
 }  // namespace cl

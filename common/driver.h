@@ -53,4 +53,8 @@ void run_shared(const std::vector<std::size_t>& order, const Run& run) {
 // the work figure only when work > 0). No line break: a lab may add to it.
 void print_time(double seconds, int steps, const char* step, double work = 0.0, const char* work_unit = "");
 
+// With --frames N, one line: "  trajectory: OUT/trajectory.{json,bin}, <frame>
+// 0, N, 2N, ... and the last (./course view OUT)". Nothing without it.
+void print_trajectory_note(const CommonOptions& options, const char* frame = "frame");
+
 }  // namespace cl

@@ -8,25 +8,33 @@
 #include "common/health.h"
 #include "common/obj.h"
 #include "common/timer.h"
+#include "common/trajectory.h"
 #include "common/window_means.h"
 
 namespace cl {
 
 namespace {
 
-// The CSV history and the OBJ frames of one run.
+// The CSV history, the OBJ frames and the trajectory of one run.
 class FrameWriter {
  public:
-  FrameWriter(const FrameOutput& output, int last_frame) : output_(output), last_frame_(last_frame) {
+  FrameWriter(const FrameOutput& output, const FramePlan& plan) : output_(output), last_frame_(plan.frames) {
     if (!output.csv_path.empty()) {
       std::vector<std::string> columns{output.index_column, "time"};
       columns.insert(columns.end(), output.columns.begin(), output.columns.end());
       columns.push_back("status");
       table_.emplace(columns);
     }
+    if (output.trajectory_every > 0) {
+      if (output.scene == nullptr) throw std::invalid_argument("run_frame_loop: a trajectory needs FrameOutput::scene");
+      TrajectoryIdentity identity{output.lab, output.method, plan.energy_name, "s"};
+      trajectory_.emplace(output.trajectory_dir, output.trajectory_every, *output.scene, identity);
+      trajectory_->reserve(trajectory_frames_kept(plan.frames, output.trajectory_every) + 1);
+    }
   }
 
-  // One judged frame: its CSV row with `status`, its OBJ when it is healthy and due.
+  // One judged frame: its CSV row with `status`, its OBJ when it is healthy
+  // and due, its trajectory frame when due (or last, or stopping).
   void add(const FrameEvent& event, const FrameMeasure& measure, const std::string& status) {
     if (table_) {
       std::vector<CsvCell> cells{static_cast<long long>(event.frame), event.time};
@@ -34,24 +42,32 @@ class FrameWriter {
       cells.emplace_back(status);
       table_->add_row(cells);
     }
-    const bool due = output_.obj_every > 0 && (event.frame % output_.obj_every == 0 || event.frame == last_frame_);
+    const bool last = event.frame == last_frame_;
+    const bool due = output_.obj_every > 0 && (event.frame % output_.obj_every == 0 || last);
     if (due && event.problem.empty() && output_.scene != nullptr) {
       write_frame_obj(output_.obj_dir, output_.lab, *output_.scene, event.state.x, event.frame, event.time);
       ++obj_frames_;
     }
-    if (output_.trajectory) output_.trajectory(event);
+    if (trajectory_ && (trajectory_->due(event.frame) || last || !event.problem.empty())) {
+      trajectory_->add(event.frame, event.time, event.state.x, measure.energy, status);
+    }
   }
 
-  // Writes the history (when asked for); the number of OBJ files written.
-  int finish() const {
+  // Writes the history and the trajectory (when asked for).
+  void finish(FrameLoopResult& result) const {
     if (table_) table_->write(output_.csv_path);
-    return obj_frames_;
+    if (trajectory_) {
+      trajectory_->finish();
+      result.trajectory_frames = trajectory_->frames_kept();
+    }
+    result.obj_frames = obj_frames_;
   }
 
  private:
   const FrameOutput& output_;
   int last_frame_;
   std::optional<CsvTable> table_;
+  std::optional<TrajectoryWriter> trajectory_;
   int obj_frames_ = 0;
 };
 
@@ -71,7 +87,7 @@ FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const
     throw std::invalid_argument("run_frame_loop: needs frames >= 0, window_frames >= 0, settle_tolerance >= 0");
   }
   FrameLoopResult result;
-  FrameWriter writer(output, plan.frames);
+  FrameWriter writer(output, plan);
   // Judges one frame: the hook, then the output; true when the run goes on.
   auto judge = [&](int frame, const FrameMeasure& measured, const std::string& problem, const std::string& status) {
     const FrameEvent event{frame, frame * plan.dt, state, problem};
@@ -92,7 +108,7 @@ FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const
   if (problem.empty()) problem = measured.problem;
   result.status = "ok";
   if (!judge(0, measured, problem, status_of(problem))) {
-    result.obj_frames = writer.finish();
+    writer.finish(result);
     return result;
   }
 
@@ -141,7 +157,7 @@ FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const
       break;
     }
   }
-  result.obj_frames = writer.finish();
+  writer.finish(result);
   return result;
 }
 

@@ -68,8 +68,8 @@ struct FramePlan {
   int settle_not_before = -1;
 };
 
-// A frame as the loop has judged it: what the lab's hook and a trajectory
-// writer see (problem empty when the frame is healthy).
+// A frame as the loop has judged it: what the lab's hook sees (problem empty
+// when the frame is healthy).
 struct FrameEvent {
   int frame = 0;
   double time = 0.0;  // s
@@ -94,10 +94,15 @@ struct FrameOutput {
   std::string obj_dir;
   std::string lab;
   const Scene* scene = nullptr;         // its triangles or springs make the mesh
-  // The trajectory writer (issue 22: every N-th frame, positions, per-spring
-  // strain and time) plugs in here: it is called for every judged frame, after
-  // the CSV row and the OBJ, and sees the frame's verdict.
-  FrameHook trajectory;
+  // The trajectory (common/trajectory.h, for ./course view): every
+  // trajectory_every-th judged frame, the last planned one and the frame that
+  // stopped the run, with its positions, strains, time, FrameMeasure::energy
+  // and status, into trajectory_dir/trajectory.{json,bin} when the loop ends
+  // (also for a run that stopped). `lab`, `scene` (needed) and `method` name
+  // the run. 0: none.
+  int trajectory_every = 0;
+  std::string trajectory_dir;
+  std::string method;
 };
 
 struct FrameLoopResult {
@@ -120,6 +125,7 @@ struct FrameLoopResult {
   double window_spread = -1.0;                // WindowMeans::relative_spread of windowed[0]
   bool settled = false;
   int obj_frames = 0;                // OBJ files written
+  int trajectory_frames = 0;         // frames kept in the trajectory
 };
 
 // The plan most labs start from: `frames` frames of `dt` s, the energy verdict

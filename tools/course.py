@@ -17,6 +17,7 @@ from cl.measure import cmd_bench, cmd_extremes
 from cl.plots import cmd_plots
 from cl.release import cmd_release
 from cl.sanitize import cmd_sanitize
+from cl.view import cmd_view
 
 USAGE = """\
 usage: ./course COMMAND [ARGS]
@@ -31,6 +32,8 @@ usage: ./course COMMAND [ARGS]
                                      reference code of the labs before NN
   autograder labNN [--out FILE.zip]  the Gradescope autograder for lab NN (its hidden tests
                                      too): build/gradescope/labNN.zip
+  view DIR [DIR2] [--output FILE]    DIR/view.html: a self-contained 3-D player of a run's frames
+                                     (a lab run with --frames N --out DIR); DIR2: two runs side by side
   run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference,
                                      where solutions/ holds it
   plots [labNN ...] [DIR] [-v]       the figures whose CSV/JSON in DIR (out/, or out/labNN_name)
@@ -45,7 +48,7 @@ Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "autograder": cmd_autograder}
+            "release": cmd_release, "autograder": cmd_autograder, "view": cmd_view}
 
 
 def main(argv):

@@ -4,13 +4,17 @@
 // and how far apart the two final states are.
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <string>
 
 #include "common/cli.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "common/timer.h"
+#include "common/trajectory.h"
 #include "gauss_seidel.h"
 #include "sweep_log.h"
 
@@ -25,13 +29,17 @@ struct LabOptions {
   double tolerance = 1e-10;
 };
 
-// K sweeps in `order` from `start`; returns the log, leaves the final state in x.
+// K sweeps in `order` from `start`; returns the log, leaves the final state in x
+// and keeps the state after every due sweep in `trajectory` (when given).
 cl::lab02::ConvergenceLog run_sweeps(const cl::Scene& scene, const Eigen::Matrix3Xd& start, int iterations,
-                                     cl::lab02::Order order, const LabOptions& lab, Eigen::Matrix3Xd& x) {
+                                     cl::lab02::Order order, const LabOptions& lab, Eigen::Matrix3Xd& x,
+                                     cl::TrajectoryWriter* trajectory = nullptr) {
+  const double no_energy = std::numeric_limits<double>::quiet_NaN();
   cl::lab02::ConvergenceLog log(scene.springs, lab.tolerance);
   cl::lab02::SweepOrder orders(scene.springs.size(), order, static_cast<std::uint64_t>(lab.seed));
   x = start;
   log.start(x);
+  if (trajectory) trajectory->add(0, 0.0, x, no_energy, "ok");
   Eigen::Matrix3Xd before;
   for (int sweep = 1; sweep <= iterations; ++sweep) {
     before = x;
@@ -39,7 +47,11 @@ cl::lab02::ConvergenceLog run_sweeps(const cl::Scene& scene, const Eigen::Matrix
     const cl::Timer timer;
     cl::lab02::gauss_seidel_sweep(x, scene.particles.inv_mass, scene.springs, sweep_order);
     const double seconds = timer.seconds();
-    if (!log.record(before, x, seconds)) {
+    const bool finite = log.record(before, x, seconds);
+    if (trajectory && (!finite || trajectory->due(sweep) || sweep == iterations)) {
+      trajectory->add(sweep, sweep, x, no_energy, finite ? "ok" : "diverged");
+    }
+    if (!finite) {
       x = before;  // the last finite state is the one reported
       break;
     }
@@ -74,7 +86,13 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("\n");
 
   Eigen::Matrix3Xd x;
-  const cl::lab02::ConvergenceLog log = run_sweeps(scene, start, options.iterations, order, lab, x);
+  std::optional<cl::TrajectoryWriter> trajectory;
+  if (options.frames > 0) {
+    trajectory.emplace(options.out, options.frames, scene,
+                       cl::TrajectoryIdentity{kLab, "gauss-seidel, " + lab.order + " order", "", "sweep"});
+  }
+  const cl::lab02::ConvergenceLog log =
+      run_sweeps(scene, start, options.iterations, order, lab, x, trajectory ? &*trajectory : nullptr);
   std::printf("%s  %s\n", cl::lab02::format_log(log).c_str(), cl::lab02::format_outcome(log).c_str());
   const double seconds = log.last().total_seconds;
   const int sweeps = log.last().sweep;
@@ -108,6 +126,8 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
     write_positions(cl::join_path(options.out, "positions.csv"), scene.particles.inv_mass, start, x,
                     lab.compare.empty() ? nullptr : &x_compare);
   }
+  if (trajectory) trajectory->finish();
+  cl::print_trajectory_note(options, "sweep");
   if (!options.summary.empty()) {
     cl::RunSummary summary;
     summary.lab = kLab;
@@ -138,7 +158,9 @@ int main(int argc, char** argv) {
   cl::CommonOptions options;
   options.scene = "perturbed-chain";
   options.iterations = 100;
-  cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary);
+  options.frames_are_sweeps = true;
+  cl::add_common_options(app, options,
+                         cl::kFlagScene | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   app.get_option("--iterations")->description("Gauss-Seidel sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   const std::vector<std::string> orders{"forward", "reverse", "random"};

@@ -7,14 +7,18 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 #include <utility>
 
 #include "common/cli.h"
+#include "common/driver.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "common/timer.h"
+#include "common/trajectory.h"
 #include "gauss_seidel.h"
 #include "jacobi.h"
 #include "sweep_log.h"
@@ -65,19 +69,35 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   Eigen::Matrix3Xd x = scene.particles.x;
   Eigen::Matrix3Xd other = x;  // Jacobi: x_next; Gauss-Seidel: the state before the sweep
   log.start(x);
+  // One frame per due sweep (and the last, and one that diverged) for ./course view.
+  std::optional<cl::TrajectoryWriter> trajectory;
+  if (options.frames > 0) {
+    const std::string method = jacobi ? "jacobi, omega " + cl::format_double(lab.omega) : "gauss-seidel";
+    trajectory.emplace(options.out, options.frames, scene, cl::TrajectoryIdentity{kLab, method, "", "sweep"});
+    trajectory->add(0, 0.0, x, std::numeric_limits<double>::quiet_NaN(), "ok");
+  }
+  auto keep = [&](int sweep, const Eigen::Matrix3Xd& state, bool finite) {
+    if (trajectory && (!finite || trajectory->due(sweep) || sweep == options.iterations)) {
+      trajectory->add(sweep, sweep, state, std::numeric_limits<double>::quiet_NaN(), finite ? "ok" : "diverged");
+    }
+  };
   for (int sweep = 1; sweep <= options.iterations; ++sweep) {
     if (jacobi) {
       const cl::Timer timer;
       cl::lab03::jacobi_sweep(x, other, inv_mass, scene.springs, incidence, lab.omega, averaging);
       const double seconds = timer.seconds();
-      if (!log.record(x, other, seconds)) break;  // x stays the last finite state
+      const bool finite = log.record(x, other, seconds);
+      keep(sweep, other, finite);
+      if (!finite) break;  // x stays the last finite state
       std::swap(x, other);
     } else {
       other = x;
       const cl::Timer timer;
       cl::lab02::gauss_seidel_sweep(x, inv_mass, scene.springs, order);
       const double seconds = timer.seconds();
-      if (!log.record(other, x, seconds)) {
+      const bool finite = log.record(other, x, seconds);
+      keep(sweep, x, finite);
+      if (!finite) {
         x = other;
         break;
       }
@@ -97,6 +117,8 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
               median_seconds > 0.0 ? projections / median_seconds : 0.0);
 
   if (!options.out.empty()) log.table().write(cl::join_path(options.out, "convergence.csv"));
+  if (trajectory) trajectory->finish();
+  cl::print_trajectory_note(options, "sweep");
   if (!options.summary.empty()) {
     cl::RunSummary summary;
     summary.lab = kLab;
@@ -136,8 +158,10 @@ int main(int argc, char** argv) {
   options.iterations = 100;
   options.method = "jacobi";
   options.methods = {"jacobi", "gauss-seidel"};
+  options.frames_are_sweeps = true;
   cl::add_common_options(app, options,
-                         cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary);
+                         cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary |
+                             cl::kFlagFrames);
   app.get_option("--iterations")->description("sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   lab.threads = omp_get_max_threads();

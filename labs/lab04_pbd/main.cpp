@@ -1,6 +1,6 @@
 // lab04_pbd: position based dynamics on a scene, frame by frame: per-frame
-// strain and energy (per_frame.csv), OBJ meshes every --frames N frames, and
-// the run summary. Two experiments, one invocation each:
+// strain and energy (per_frame.csv), the trajectory (./course view) and OBJ
+// meshes every --frames N frames, and the run summary. Two experiments, one invocation each:
 //   --sweep-iterations 1,2,...,128          steady strain against K  -> strain_vs_iterations.csv
 //   --sweep-substeps 1,2,...,64 --cost C    substeps × K = C fixed   -> substeps.csv
 #include <algorithm>
@@ -25,7 +25,6 @@ constexpr const char* kLab = CL_LAB_NAME;
 struct LabOptions {
   int substeps = 1;
   double omega = 1.0;
-  int frames_every = 0;            // 0: no OBJ frames
   double window_seconds = 1.0;     // the averaging window
   double settle_tolerance = 0.02;  // sweeps: stop once three windows agree to this
   double energy_seconds = 2.0;     // sweeps: the energy is compared at this time
@@ -53,7 +52,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const std::string frames_dir = cl::join_path(options.out, "frames");
-  if (lab.frames_every > 0) cl::ensure_directory(frames_dir);
+  if (options.frames > 0) cl::ensure_directory(frames_dir);
 
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const cl::lab04::PbdSettings settings = frame_settings(scene, options, lab, options.iterations);
@@ -65,10 +64,13 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = cl::lab04::frame_columns();
-  output.obj_every = lab.frames_every;
+  output.obj_every = options.frames;
   output.obj_dir = frames_dir;
   output.lab = kLab;
   output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = options.method;
 
   cl::Particles& particles = scene.particles;
   const cl::lab04::RunResult result =
@@ -102,6 +104,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::print_time(result.seconds, result.frames_done, "frame", projections, "spring projection");
   std::printf("\n");
   if (result.obj_frames > 0) std::printf("  %d OBJ frames in %s\n", result.obj_frames, frames_dir.c_str());
+  cl::print_trajectory_note(options);
 
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
@@ -216,7 +219,9 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (lab.frames_every > 0 && options.out.empty()) throw cl::InputError("--frames: needs --out DIR for the OBJ files");
+  if (options.frames > 0 && options.out.empty()) {
+    throw cl::InputError("--frames: needs --out DIR for the trajectory and the OBJ files");
+  }
   const bool sweep = !lab.sweep_iterations.empty() || !lab.sweep_substeps.empty();
   if (!sweep) {
     if (!lab.sweep_scenes.empty()) {
@@ -224,7 +229,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
     }
     return run_one(options, lab);
   }
-  if (lab.frames_every > 0) throw cl::InputError("--frames: not with a sweep (run one configuration instead)");
+  if (options.frames > 0) throw cl::InputError("--frames: not with a sweep (run one configuration instead)");
   if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
   std::vector<std::pair<int, int>> points;  // (substeps, iterations)
   if (!lab.sweep_iterations.empty()) {
@@ -255,7 +260,10 @@ int main(int argc, char** argv) {
   options.iterations = 10;
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
-                             cl::kFlagOut | cl::kFlagSummary);
+                             cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
+  app.get_option("--frames")
+      ->description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
+                    "mesh into OUT/frames/");
   LabOptions lab;
   app.add_option("--substeps", lab.substeps, "PBD steps of dt/n per frame")
       ->check(CLI::Range(1, 1'000'000))
@@ -263,8 +271,6 @@ int main(int argc, char** argv) {
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor ω, as in lab 03 (0 leaves x unchanged; >= 2 diverges)")
       ->check(cl::finite_number(true))
       ->capture_default_str();
-  app.add_option("--frames", lab.frames_every, "write an OBJ of the mesh every N frames into OUT/frames/")
-      ->check(CLI::Range(1, 100'000'000));
   app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady strain")
       ->check(cl::finite_in(1e-9, 1e9))
       ->capture_default_str();

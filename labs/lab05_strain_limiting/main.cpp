@@ -104,6 +104,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
   output.columns = cl::lab05::step_columns();
+  output.lab = kLab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = "limit " + lab.limit;
   cl::Particles& particles = scene.particles;
   const cl::lab05::RunResult result =
       cl::lab05::run_steps(particles, system, settings, scene.steps, checks_energy(limit), nullptr, output);
@@ -128,6 +133,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   const std::string outside = band_problem(result, limit, lab, options.iterations);
   if (!outside.empty()) std::printf("  WARNING: %s\n", outside.c_str());
+  cl::print_trajectory_note(options, "step");
   cl::print_time(result.seconds, result.steps_done, "step");
   std::printf("\n");
   // A limited run whose energy rose past the scene's scale and did not stop:
@@ -358,6 +364,9 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.stability_map && !lab.compare_limits.empty()) {
     throw cl::InputError("--stability-map: not with --compare-limits (one experiment per run)");
   }
+  if (options.frames > 0 && (lab.stability_map || !lab.compare_limits.empty())) {
+    throw cl::InputError("--frames: only for one run (not with --stability-map or --compare-limits)");
+  }
   if (lab.stability_map) return stability_map(options, lab);
   if (!lab.compare_limits.empty()) {
     if (!options.summary.empty()) throw cl::InputError("--summary: --compare-limits writes CSVs, not a run summary");
@@ -378,7 +387,7 @@ int main(int argc, char** argv) {
   options.iterations = 10;
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
-                             cl::kFlagSummary);
+                             cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--limit", lab.limit, "the limiter run after each step")
       ->check(CLI::IsMember({"none", "springs", "triangles-area", "triangles-stretch"}))

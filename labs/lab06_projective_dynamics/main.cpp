@@ -16,6 +16,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -89,6 +90,11 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
   output.columns = cl::lab06::step_columns();
+  output.lab = kLab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = options.method;
   cl::Particles& particles = scene.particles;
   const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
@@ -126,6 +132,7 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   std::printf("\n");
 
+  cl::print_trajectory_note(options, "step");
   if (!options.summary.empty()) {
     cl::RunSummary summary =
         cl::stepping_summary(kLab, cl::lab06::method_name(method), scene, particles, strain, result.seconds);
@@ -295,6 +302,9 @@ int run_convergence(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (lab.convergence && options.frames > 0) {
+    throw cl::InputError("--frames: only for one run (not with --convergence)");
+  }
   if (lab.convergence) return run_convergence(options, lab);
   if (!lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
   return run_steps(options, lab);
@@ -314,7 +324,7 @@ int main(int argc, char** argv) {
   options.iterations = 10;
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
-                             cl::kFlagOut | cl::kFlagSummary);
+                             cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--tolerance", lab.tolerance,
                  "stop a step's iterations once the objective's relative decrease falls below this (0: run all K)")

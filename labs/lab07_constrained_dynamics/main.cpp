@@ -13,6 +13,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
@@ -162,6 +163,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = {"max_constraint_error", "max_strain", "kinetic", "potential", "spring_energy", "total_energy",
                     "step_seconds", "stabilize_seconds"};
+  output.lab = kLab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = options.method + (lab.stabilize ? ", stabilized" : "");
   const cl::FrameLoopResult run = cl::run_frame_loop(particles, step, measure, plan, output);
   const int frames_done = run.frames_done;
   const int problem_frame = run.problem_frame;
@@ -206,6 +212,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("\n");
   }
 
+  cl::print_trajectory_note(options, "frame");
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, run.seconds);
     summary.extra["multipliers"] = std::vector<double>(lambda.data(), lambda.data() + lambda.size());
@@ -364,6 +371,9 @@ int run_compare(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (options.frames > 0 && (!lab.compare_pbd.empty() || !lab.compare_substeps.empty())) {
+    throw cl::InputError("--frames: only for one run (not with --compare-pbd or --compare-substeps)");
+  }
   if (!lab.compare_pbd.empty() || !lab.compare_substeps.empty()) return run_compare(options, lab);
   return run_one(options, lab);
 }
@@ -381,7 +391,7 @@ int main(int argc, char** argv) {
   options.methods = {"kkt", "schur"};
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
-                             cl::kFlagSummary);
+                             cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_flag("--stabilize", lab.stabilize,
                "after every step, project the positions once onto the hard constraints (velocities unchanged)");

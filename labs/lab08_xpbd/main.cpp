@@ -66,6 +66,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = cl::lab08::frame_columns();
+  output.lab = kLab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = options.method;
 
   cl::Particles& particles = scene.particles;
   const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, nullptr, output);
@@ -107,6 +112,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::print_time(result.seconds, result.frames_done, "frame", projections, "spring projection");
   std::printf("\n");
 
+  cl::print_trajectory_note(options, "frame");
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
@@ -205,6 +211,7 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.sweep_iterations.empty()) return run_one(options, lab);
+  if (options.frames > 0) throw cl::InputError("--frames: only for one run (not with --sweep-iterations)");
   if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
   return run_sweep(options, lab);
 }
@@ -223,7 +230,7 @@ int main(int argc, char** argv) {
   options.iterations = 10;
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
-                             cl::kFlagOut | cl::kFlagSummary);
+                             cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--substeps", lab.substeps, "steps of dt/n per frame")
       ->check(CLI::Range(1, 1'000'000))

@@ -18,6 +18,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/metrics.h"
@@ -136,6 +137,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = {"max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda", "kinetic",
                     "potential", "spring_energy", "total_energy", "step_seconds"};
+  output.lab = kLab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = options.method + ", K_g " + lab.geometric_stiffness;
   const cl::FrameLoopResult run = cl::run_frame_loop(particles, step, measure, plan, output);
   const int frames_done = run.frames_done;
   const int problem_frame = run.problem_frame;
@@ -168,6 +174,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  multipliers from %.6g N to %.6g N (negative: tension)\n", lambda.minCoeff(), lambda.maxCoeff());
   }
 
+  cl::print_trajectory_note(options, "frame");
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, seconds);
     summary.extra["geometric_stiffness"] = lab.geometric_stiffness;
@@ -371,6 +378,9 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (options.frames > 0 && !lab.sweep_mass_ratios.empty()) {
+    throw cl::InputError("--frames: only for one run (not with --sweep-mass-ratios)");
+  }
   if (!lab.sweep_mass_ratios.empty()) return run_sweep(options, lab);
   return run_one(options, lab);
 }
@@ -389,7 +399,7 @@ int main(int argc, char** argv) {
   options.methods = {"schur", "kkt"};
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
-                             cl::kFlagSummary);
+                             cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--geometric-stiffness", lab.geometric_stiffness,
                  "add K_g to the step (on) or not (off: lab 07's step)")

@@ -16,6 +16,7 @@
 
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/hierarchy.h"
 #include "common/metrics.h"
 #include "common/output.h"
@@ -30,7 +31,6 @@ constexpr const char* kLab = CL_LAB_NAME;
 struct LabOptions {
   int levels = 3;
   std::vector<int> iterations_per_level{8};
-  int frames_every = 0;  // 0: no OBJ frames
   bool converge = false;
   std::vector<std::string> sweep_scenes;
   std::vector<int> sweep_levels;
@@ -88,15 +88,18 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.iterations = per_level(lab, lab.levels);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const std::string frames_dir = cl::join_path(options.out, "frames");
-  if (lab.frames_every > 0) cl::ensure_directory(frames_dir);
+  if (options.frames > 0) cl::ensure_directory(frames_dir);
 
   cl::FrameOutput output;
   if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
   output.columns = cl::lab10::frame_columns();
-  output.obj_every = lab.frames_every;
+  output.obj_every = options.frames;
   output.obj_dir = frames_dir;
   output.lab = kLab;
   output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = "hpbd, " + std::to_string(lab.levels) + (lab.levels == 1 ? " level" : " levels");
 
   cl::Particles& particles = scene.particles;
   const cl::lab10::RunResult result =
@@ -127,6 +130,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (result.projections > 0) std::printf(", %.3e s per projection", result.seconds / static_cast<double>(result.projections));
   std::printf("\n");
   if (result.obj_frames > 0) std::printf("  %d OBJ frames in %s\n", result.obj_frames, frames_dir.c_str());
+  cl::print_trajectory_note(options);
 
   if (!options.summary.empty()) {
     cl::RunSummary summary =
@@ -260,12 +264,14 @@ int run_converge(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.converge) {
-    if (lab.frames_every > 0) throw cl::InputError("--frames: not with --converge");
+    if (options.frames > 0) throw cl::InputError("--frames: not with --converge");
     return run_converge(options, lab);
   }
   if (!lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --converge");
   if (!lab.sweep_levels.empty()) throw cl::InputError("--sweep-levels: only with --converge");
-  if (lab.frames_every > 0 && options.out.empty()) throw cl::InputError("--frames: needs --out DIR for the OBJ files");
+  if (options.frames > 0 && options.out.empty()) {
+    throw cl::InputError("--frames: needs --out DIR for the trajectory and the OBJ files");
+  }
   return run_one(options, lab);
 }
 
@@ -277,7 +283,12 @@ int main(int argc, char** argv) {
                CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "flat-curtain-64";
-  cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary);
+  cl::add_common_options(app, options,
+                         cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary |
+                             cl::kFlagFrames);
+  app.get_option("--frames")
+      ->description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
+                    "mesh into OUT/frames/");
   LabOptions lab;
   app.add_option("--levels", lab.levels, "levels of the hierarchy (1: plain Gauss-Seidel PBD)")
       ->check(CLI::Range(1, 16))
@@ -288,8 +299,6 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->check(CLI::Range(0, 1'000'000))
       ->capture_default_str();
-  app.add_option("--frames", lab.frames_every, "write an OBJ of the mesh every N frames into OUT/frames/")
-      ->check(CLI::Range(1, 100'000'000));
   app.add_flag("--converge", lab.converge,
                "experiment 1: one step from rest, count the projections to each --targets max strain");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--converge: scenes to measure (default: --scene)")

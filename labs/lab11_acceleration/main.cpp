@@ -8,14 +8,17 @@
 //                  iterations and seconds to each target
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "accelerated.h"
 #include "common/cli.h"
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/output.h"
 #include "common/summary.h"
+#include "common/trajectory.h"
 
 namespace {
 
@@ -71,9 +74,21 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
     table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.max_strain,
                    r.omega, static_cast<long long>(r.restarted), r.seconds});
   };
+  // Every due step (and the last, and one that stopped the run) for ./course view.
+  std::optional<cl::TrajectoryWriter> trajectory;
+  if (options.frames > 0) {
+    trajectory.emplace(options.out, options.frames, scene, cl::TrajectoryIdentity{kLab, options.method});
+  }
+  const cl::lab11::StepCallback on_step = [&](const cl::lab11::StepRecord& r, const cl::Particles& state) {
+    if (r.step % options.frames == 0 || r.step == scene.steps || !r.problem.empty()) {
+      trajectory->add(r.step, r.step * scene.dt, state.x, r.total_energy, r.problem.empty() ? "ok" : r.problem);
+    }
+  };
   cl::Particles& particles = scene.particles;
-  const cl::lab11::RunResult result = cl::lab11::run_steps(particles, solver, method, settings, scene.steps, nullptr,
-                                                           options.out.empty() ? nullptr : on_iteration);
+  const cl::lab11::RunResult result =
+      cl::lab11::run_steps(particles, solver, method, settings, scene.steps, trajectory ? on_step : nullptr,
+                           options.out.empty() ? nullptr : on_iteration);
+  if (trajectory) trajectory->finish();
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const bool chebyshev = method == Method::kPdChebyshev || method == Method::kJacobiChebyshev;
   std::printf("%s: scene %s, %s, K = %d, rho %.6f%s, gamma %g, delay %d, history %d, %d steps of %.4g s\n", kLab,
@@ -85,6 +100,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
               "per step)\n", strain.max, strain.rms, result.iterations_done, result.restarts,
               result.failed_line_searches, result.seconds, result.steps_done ? result.seconds / result.steps_done : 0.0);
   if (!options.out.empty()) table.write(cl::join_path(options.out, "iterations.csv"));
+  cl::print_trajectory_note(options, "step");
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
@@ -168,7 +184,7 @@ int main(int argc, char** argv) {
   options.methods = {"pd", "pd-chebyshev", "pd-lbfgs", "newton", "jacobi", "jacobi-chebyshev", "gauss-seidel"};
   options.iterations = 10;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
-                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary);
+                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   double rho = -1.0;
   app.add_option("--rho", rho, "the spectral radius for Chebyshev, in [0, 1) (default: estimated per scene)")
@@ -193,6 +209,9 @@ int main(int argc, char** argv) {
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
+    if (lab.convergence && options.frames > 0) {
+      throw cl::InputError("--frames: only for a run of steps (not with --convergence)");
+    }
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
 }

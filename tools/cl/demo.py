@@ -1,15 +1,21 @@
-"""./course demo and ./course run: the labs' executables."""
+"""./course demo and ./course run: the labs' executables; the demo's views
+(./course view of every run that kept a trajectory, and demo.txt's `view:`
+comparisons) and out/index.html, the page that links them all."""
 import argparse
+import html
 import json
 import os
 import shlex
 import subprocess
 import sys
+from html.parser import HTMLParser
+from pathlib import Path
 
 from .base import ROOT, CourseError, show, under_root
 from .build import BuildFailure, build_targets, configure
-from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab
+from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
 from .plots import plots_failed, run_plots
+from .view import write_view
 
 
 def run_demos(out, echo=True, labs=None, student_fallback=True):
@@ -45,6 +51,96 @@ def run_demos(out, echo=True, labs=None, student_fallback=True):
             if done.returncode != 0:
                 raise CourseError(f"{shown} exited with code {done.returncode}",
                                   details=done.stderr.splitlines())
+
+
+def comparison_name(first, second):
+    """The file of a `view:` comparison, in its lab's output folder."""
+    return f"view-{Path(first).name}-vs-{Path(second).name}.html"
+
+
+def write_views(out, labs=None, echo=True):
+    """The views of OUT/<lab>: DIR/view.html for every DIR with a trajectory,
+    and OUT/<lab>/view-A-vs-B.html for each `view: {out}/A {out}/B` line of the
+    lab's demo.txt. Returns the paths written; raises (CourseError) on a refusal."""
+    written = []
+    for lab in labs or lab_dirs():
+        lab_out = out / lab
+        if not lab_out.is_dir():
+            continue
+        for header in sorted(lab_out.rglob("trajectory.json")):
+            written.append(write_view([header.parent]))
+        for dirs in view_lines(lab):
+            folders = [Path(d.replace("{out}", str(lab_out))) for d in dirs]
+            written.append(write_view(folders, lab_out / comparison_name(*folders)))
+    if echo:
+        for path in written:
+            print(f"  view: {show(path)}")
+    return written
+
+
+def _href(path, out):
+    """A link from out/index.html to `path`."""
+    return html.escape(os.path.relpath(path, out).replace(os.sep, "/"), quote=True)
+
+
+def index_page(out):
+    """out/index.html's text: per lab, its views, its figures (thumbnails) and its handout."""
+    sections = []
+    for lab in lab_dirs():
+        lab_out = out / lab
+        if not lab_out.is_dir():
+            continue
+        figures = sorted(p for p in lab_out.rglob("*") if p.suffix in (".png", ".gif"))
+        views = sorted(p for p in lab_out.rglob("*.html") if p.name == "view.html" or p.name.startswith("view-"))
+        if not figures and not views:
+            continue
+        items = "".join(f'<li><a href="{_href(v, out)}">{html.escape(v.relative_to(lab_out).as_posix())}</a></li>'
+                        for v in views)
+        thumbs = "".join(f'<a href="{_href(f, out)}" title="{_href(f, out)}"><img src="{_href(f, out)}" '
+                         f'alt="{_href(f, out)}" loading="lazy"></a>' for f in figures)
+        readme = ROOT / "labs" / lab / "README.md"
+        handout = f' · <a href="{_href(readme, out)}">handout</a>' if readme.is_file() else ""
+        sections.append(f'<section id="{lab}"><h2>{lab}{handout}</h2>'
+                        + (f"<h3>views (open, then play, orbit, compare)</h3><ul>{items}</ul>" if items else "")
+                        + (f'<h3>figures</h3><div class="thumbs">{thumbs}</div>' if thumbs else "")
+                        + "</section>")
+    contents = "".join(f'<a href="#{lab}">{lab[:5]}</a> ' for lab in lab_dirs() if (out / lab).is_dir())
+    return f"""<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>Constraint Labs: the course's runs</title>
+<style>
+body {{ font: 14px sans-serif; margin: 1em 2em; color: #222; }}
+.thumbs img {{ height: 150px; margin: 4px; border: 1px solid #ccc; }}
+h2 {{ border-bottom: 1px solid #ccc; }}
+</style></head><body>
+<h1>Constraint Labs: the course's runs</h1>
+<p>Every lab's figures and views from <code>./course demo</code>. A view is one file: it plays the run's
+frames (play, step, slider, speed, loop), orbits (drag), zooms (wheel) and pans (right drag); springs are
+coloured by strain. Make your own with <code>./course view DIR [DIR2]</code>.</p>
+<p>{contents}</p>
+{"".join(sections)}
+</body></html>
+"""
+
+
+def write_index(out):
+    path = out / "index.html"
+    path.write_text(index_page(out))
+    return path
+
+
+def index_links(out):
+    """Every href and src of out/index.html that does not resolve to a file."""
+    missing = []
+
+    class Links(HTMLParser):
+        def handle_starttag(self, tag, attrs):
+            for name, value in attrs:
+                if name in ("href", "src") and value and not value.startswith("#"):
+                    if not (out / value).is_file():
+                        missing.append(value)
+
+    Links().feed((out / "index.html").read_text())
+    return missing
 
 
 def summaries(out):
@@ -94,8 +190,10 @@ def cmd_demo(argv):
     out = under_root(parser.parse_args(argv).out)
     run_demos(out)
     outcomes = run_plots(out)
+    write_views(out)
+    index = write_index(out)
     print_summary_table(out)
-    print(f"\noutputs: {show(out)}/")
+    print(f"\noutputs: {show(out)}/; all of it on one page: {show(index)} (file://{index.resolve()})")
     return 1 if plots_failed(outcomes) else 0
 
 

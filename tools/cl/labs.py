@@ -1,5 +1,5 @@
 """The labs: their folders, the build's manifest of them (build/labs.json),
-their demo.txt and rejects.txt.
+their demo.txt (runs, and `view:` comparisons) and rejects.txt.
 
 CMake writes build/labs.json (cmake/AddLab.cmake): per lab its student files,
 whether it has a reference, its earlier labs and which of them the graded tests
@@ -71,13 +71,26 @@ def lab_targets(lab, solutions=False):
     return targets
 
 
-def demo_lines(lab):
-    """The argument lists in labs/LAB/demo.txt."""
+VIEW_PREFIX = "view:"
+
+
+def _demo_text_lines(lab):
     demo = ROOT / "labs" / lab / "demo.txt"
     if not demo.is_file():
         return []
     lines = (line.strip() for line in demo.read_text().splitlines())
-    return [shlex.split(line) for line in lines if line and not line.startswith("#")]
+    return [line for line in lines if line and not line.startswith("#")]
+
+
+def demo_lines(lab):
+    """The argument lists in labs/LAB/demo.txt (its runs; not its `view:` lines)."""
+    return [shlex.split(line) for line in _demo_text_lines(lab) if not line.startswith(VIEW_PREFIX)]
+
+
+def view_lines(lab):
+    """The comparisons in labs/LAB/demo.txt: `view: DIR DIR2` lines, as [DIR, DIR2]
+    ({out} not yet replaced)."""
+    return [shlex.split(line[len(VIEW_PREFIX):]) for line in _demo_text_lines(lab) if line.startswith(VIEW_PREFIX)]
 
 
 def reject_lines(lab):
