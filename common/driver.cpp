@@ -1,8 +1,24 @@
 #include "common/driver.h"
 
 #include <cstdio>
+#include <utility>
+
+#include "common/output.h"
 
 namespace cl {
+
+FrameOutput frame_output(const CommonOptions& options, const char* lab, const Scene& scene, const char* csv_name,
+                         std::vector<std::string> columns, std::string method) {
+  FrameOutput output;
+  if (!options.out.empty()) output.csv_path = join_path(options.out, csv_name);
+  output.columns = std::move(columns);
+  output.lab = lab;
+  output.scene = &scene;
+  output.trajectory_every = options.frames;
+  output.trajectory_dir = options.out;
+  output.method = std::move(method);
+  return output;
+}
 
 std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<std::string>& names,
                                const std::string& lab_scene_dir) {

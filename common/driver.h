@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/cli.h"
+#include "common/frame_loop.h"
 #include "common/scene.h"
 
 namespace cl {
@@ -19,6 +20,13 @@ namespace cl {
 // applied). Throws InputError for the first that does not load.
 std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<std::string>& names,
                                const std::string& lab_scene_dir);
+
+// What a run of the frame loop writes, as every lab's driver sets it: the
+// per-frame CSV OUT/csv_name (no --out: none) with `columns`, and with
+// --frames N the trajectory into OUT, named by `lab`, `scene` (which must
+// outlive the loop) and `method`. OBJ frames stay the lab's to ask for.
+FrameOutput frame_output(const CommonOptions& options, const char* lab, const Scene& scene, const char* csv_name,
+                         std::vector<std::string> columns, std::string method);
 
 // The indices 0 … n−1 of `costs`, costliest first (ties keep their order).
 std::vector<std::size_t> costliest_first(const std::vector<double>& costs);

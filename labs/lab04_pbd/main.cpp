@@ -61,16 +61,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
-  output.columns = cl::lab04::frame_columns();
+  cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_frame.csv", cl::lab04::frame_columns(), options.method);
   output.obj_every = options.frames;
   output.obj_dir = frames_dir;
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = options.method;
 
   cl::Particles& particles = scene.particles;
   const cl::lab04::RunResult result =

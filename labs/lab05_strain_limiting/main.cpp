@@ -101,14 +101,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab05::StepSettings settings = step_settings(scene, options, lab, limit);
 
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
-  output.columns = cl::lab05::step_columns();
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = "limit " + lab.limit;
+  cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab05::step_columns(), "limit " + lab.limit);
   cl::Particles& particles = scene.particles;
   const cl::lab05::RunResult result =
       cl::lab05::run_steps(particles, system, settings, scene.steps, checks_energy(limit), nullptr, output);

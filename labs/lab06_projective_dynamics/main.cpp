@@ -87,14 +87,8 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.iterations = options.iterations;
   settings.tolerance = lab.tolerance;
 
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
-  output.columns = cl::lab06::step_columns();
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = options.method;
+  cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab06::step_columns(), options.method);
   cl::Particles& particles = scene.particles;
   const cl::lab06::RunResult result = cl::lab06::run_steps(particles, solver, settings, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);

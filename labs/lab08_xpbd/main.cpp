@@ -63,14 +63,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
   const double window_seconds = plan.window_frames * scene.dt;
 
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
-  output.columns = cl::lab08::frame_columns();
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = options.method;
+  cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_frame.csv", cl::lab08::frame_columns(), options.method);
 
   cl::Particles& particles = scene.particles;
   const cl::lab08::RunResult result = cl::lab08::run_frames(particles, constraints, settings, plan, nullptr, output);

@@ -133,15 +133,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                             {}};
   };
   const cl::FramePlan plan = cl::frame_plan(scene.steps, scene.dt, scale);
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
-  output.columns = {"max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda", "kinetic",
-                    "potential", "spring_energy", "total_energy", "step_seconds"};
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = options.method + ", K_g " + lab.geometric_stiffness;
+  cl::FrameOutput output = cl::frame_output(options, kLab, scene, "per_frame.csv",
+                                            {"max_constraint_error", "max_transverse_speed", "min_lambda", "max_lambda",
+                                             "kinetic", "potential", "spring_energy", "total_energy", "step_seconds"},
+                                            options.method + ", K_g " + lab.geometric_stiffness);
   const cl::FrameLoopResult run = cl::run_frame_loop(particles, step, measure, plan, output);
   const int frames_done = run.frames_done;
   const int problem_frame = run.problem_frame;

@@ -90,16 +90,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const std::string frames_dir = cl::join_path(options.out, "frames");
   if (options.frames > 0) cl::ensure_directory(frames_dir);
 
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_frame.csv");
-  output.columns = cl::lab10::frame_columns();
+  cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_frame.csv", cl::lab10::frame_columns(),
+                       "hpbd, " + std::to_string(lab.levels) + (lab.levels == 1 ? " level" : " levels"));
   output.obj_every = options.frames;
   output.obj_dir = frames_dir;
-  output.lab = kLab;
-  output.scene = &scene;
-  output.trajectory_every = options.frames;
-  output.trajectory_dir = options.out;
-  output.method = "hpbd, " + std::to_string(lab.levels) + (lab.levels == 1 ? " level" : " levels");
 
   cl::Particles& particles = scene.particles;
   const cl::lab10::RunResult result =

@@ -71,9 +71,8 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
     table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.omega,
                    static_cast<long long>(r.restarted), r.seconds});
   };
-  cl::FrameOutput output;
-  if (!options.out.empty()) output.csv_path = cl::join_path(options.out, "per_step.csv");
-  output.columns = cl::lab12::step_columns();
+  const cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab12::step_columns(), options.method);
   cl::Particles& particles = scene.particles;
   const cl::lab12::RunResult result = cl::lab12::run_steps(particles, solver, method, settings, scene.steps, nullptr,
                                                            options.out.empty() ? nullptr : on_iteration, output);
@@ -86,6 +85,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   std::printf("  max strain %.3e, rms %.3e; %lld sweeps, %d restarts; %.3e s (%.3e s per step)\n", strain.max,
               strain.rms, result.iterations_done, result.restarts, result.seconds,
               result.steps_done ? result.seconds / result.steps_done : 0.0);
+  cl::print_trajectory_note(options, "step");
   if (!options.out.empty()) table.write(cl::join_path(options.out, "iterations.csv"));
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
@@ -172,7 +172,7 @@ int main(int argc, char** argv) {
   options.methods = {"vbd", "vbd-chebyshev"};
   options.iterations = 10;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
-                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary);
+                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   double rho = -1.0;
   app.add_option("--init", lab.init, "the first iterate: inertia (y) or adaptive (Chen et al. 2024)")
@@ -191,6 +191,7 @@ int main(int argc, char** argv) {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
+    if (lab.convergence && options.frames > 0) throw cl::InputError("--frames: only for a run of steps");
     lab.settings.init = cl::lab12::init_from_name(lab.init);
     omp_set_num_threads(lab.threads);
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
