@@ -171,7 +171,7 @@ TEST_CASE("a step that could not be taken stops the run, is not counted, and kee
   CHECK_THAT(lines[5], StartsWith("4,") && Contains("singular: J is rank deficient"));
 }
 
-TEST_CASE("a step's own problem is prefixed in the history; the loop's clock or the step's seconds",
+TEST_CASE("a step's own problem is prefixed in the history and the loop's clock or the step's seconds is kept",
           "[common][frame_loop]") {
   Kicked run;
   run.kick = 0.0;

@@ -215,7 +215,7 @@ TEST_CASE("the size cap refuses a run too large and its suggested --frames N fit
   CHECK(cl::trajectory_frames_kept(last, suggested) * frame <= static_cast<double>(cl::kTrajectoryCapBytes));
 }
 
-TEST_CASE("--frames needs --out, checked when the scene is loaded", "[common][trajectory]") {
+TEST_CASE("a trajectory (--frames) needs --out, checked when the scene is loaded", "[common][trajectory]") {
   cl::CommonOptions options;
   options.scene = "curtain-8";
   options.frames = 2;
