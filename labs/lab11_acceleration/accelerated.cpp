@@ -539,27 +539,14 @@ double total_energy(const Particles& particles, const std::vector<Spring>& sprin
 }  // namespace
 
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step, const RunIterationCallback& on_iteration) {
+                    const StepCallback& on_step, const RunIterationCallback& on_iteration, const FrameOutput& output) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
   const std::vector<Spring>& springs = solver.springs();
   const bool elastic = minimises_objective(method);
   RunResult result;
   StepRecord record;
-  record.strain = strain_stats(particles.x, springs);
-  record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
-  result.energy_start = result.energy_end = record.total_energy;
-  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
-                       (elastic ? lab06::spring_energy(particles.x, springs) : 0.0);
-  record.problem = health_problem(particles, record.strain);
-  if (on_step) on_step(record, particles);
-  if (!record.problem.empty()) {
-    result.problem = record.problem;
-    result.problem_step = 0;
-    return result;
-  }
-  for (int s = 1; s <= steps; ++s) {
-    record = StepRecord{};
-    record.step = s;
+  StepReport report;
+  auto step = [&](int s) {
     IterationCallback each = nullptr;
     if (on_iteration) {
       each = [&](const IterationRecord& iteration) {
@@ -567,26 +554,41 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
         return false;
       };
     }
-    record.report = solver.step(particles, method, settings, each);
-    result.seconds += record.report.seconds;
-    result.iterations_done += record.report.iterations_done;
-    result.restarts += record.report.restarts;
-    result.failed_line_searches += record.report.failed_line_searches;
-    result.steps_done = s;
+    report = solver.step(particles, method, settings, each);
+    result.iterations_done += report.iterations_done;
+    result.restarts += report.restarts;
+    result.failed_line_searches += report.failed_line_searches;
+    return StepVerdict{report.problem, true, report.seconds};
+  };
+  auto measured = [&](int s, double) {
+    record = StepRecord{};
+    record.step = s;
+    if (s > 0) record.report = report;
     record.strain = strain_stats(particles.x, springs);
     record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
-    result.energy_end = record.total_energy;
-    record.problem = record.report.problem;
-    if (record.problem.empty()) record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty()) record.problem = energy_rise_problem(result.energy_end - result.energy_start, scale);
-    if (on_step) on_step(record, particles);
-    if (!record.problem.empty()) {
-      result.problem = record.problem;
-      result.problem_step = s;
-      return result;
-    }
-  }
+    return FrameMeasure{record.strain, record.total_energy, {},
+                        {record.report.objective, static_cast<long long>(record.report.iterations_done),
+                         static_cast<long long>(record.report.converged ? 1 : 0),
+                         static_cast<long long>(record.report.restarts),
+                         static_cast<long long>(record.report.failed_line_searches), record.report.seconds,
+                         record.strain.max, record.strain.rms, record.total_energy},
+                        {}};
+  };
+  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
+                       (elastic ? lab06::spring_energy(particles.x, springs) : 0.0);
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, frame_plan(steps, solver.dt(), scale),
+                                             with_index, record_hook(record, on_step));
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
   return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"objective", "iterations", "converged", "restarts", "failed_line_searches", "seconds", "max_strain",
+          "rms_strain", "total_energy"};
 }
 
 }  // namespace cl::lab11

@@ -3,7 +3,8 @@
 // acceleration.h, built on the earlier labs' code through their headers:
 // lab 06's local step, global step, system matrix, objective and Newton step;
 // lab 03's Jacobi sweep and lab 02's Gauss-Seidel sweep inside lab 04's PBD
-// step. It owns the state; the functions of acceleration.h stay stateless.
+// step; and the loop over a scene's steps on common/frame_loop.h. It owns the
+// state; the functions of acceleration.h stay stateless.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "../lab06_projective_dynamics/simulation.h"
 #include "acceleration.h"
 #include "common/constraints.h"
+#include "common/frame_loop.h"
 #include "common/particles.h"
 #include "common/sparse.h"
 #include "pbd.h"
@@ -146,10 +148,17 @@ struct RunResult {
   int problem_step = -1;
 };
 
-// Runs `steps` steps; stops at the first failed or unhealthy step
-// (common/health.h), or one whose total energy rose more than the scene's
-// energy scale above its start.
+// Runs `steps` steps in common/frame_loop.h's loop: it stops at the first
+// failed or unhealthy step (common/health.h), or one whose total energy rose
+// more than the scene's energy scale (plus, for the PD family, its initial
+// elastic energy) above its start, and writes the per-step CSV of
+// step_columns() and the trajectory when `output` asks for them.
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr);
+                    const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr,
+                    const FrameOutput& output = {});
+
+// objective, iterations, converged, restarts, failed_line_searches, seconds,
+// max_strain, rms_strain, total_energy.
+std::vector<std::string> step_columns();
 
 }  // namespace cl::lab11
