@@ -123,6 +123,99 @@ double strain_merit(const Eigen::Matrix3Xd& x, const std::vector<Spring>& spring
   return merit;
 }
 
+// ------------------------------------------------------------------ the accelerated loop
+
+StepReport accelerated_iterations(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& held, const Eigen::VectorXd& inv_mass,
+                                  const PlainIteration& plain_iteration, const Merit& merit,
+                                  const AcceleratedLoop& loop, const IterateCallback& on_iterate) {
+  const bool tracked = loop.accelerated || loop.tolerance > 0.0 || on_iterate;
+  StepReport report;
+  Clock clock;
+  auto record = [&](const IterationRecord& values) {
+    if (!on_iterate) return false;
+    const Timer timer;
+    IterationRecord copy = values;
+    copy.seconds = clock.seconds();
+    const bool stop = on_iterate(copy, x);
+    clock.excluded += timer.seconds();
+    return stop;
+  };
+  // The plain iteration evaluates the merit only for the records, outside its time.
+  auto evaluate = [&](const Eigen::Matrix3Xd& q) {
+    const Timer timer;
+    const double value = merit(q);
+    if (!loop.accelerated && loop.tolerance == 0.0) clock.excluded += timer.seconds();
+    return value;
+  };
+  double g = std::numeric_limits<double>::quiet_NaN();
+  bool stopped = false;
+  if (tracked) {
+    g = evaluate(x);
+    stopped = record({0, g, 0.0, 1.0, false, 0.0});
+  }
+  Schedule schedule{loop.rho, loop.delay};
+  Eigen::Matrix3Xd previous = x, plain(3, x.cols()), next;
+  for (int k = 1; k <= loop.iterations && !stopped; ++k) {
+    plain_iteration(x, plain);
+    IterationRecord values{k, 0.0, 0.0, 1.0, false, 0.0};
+    double value = std::numeric_limits<double>::quiet_NaN();
+    if (loop.accelerated) {
+      values.omega = schedule.next(k);
+      if (values.omega == 1.0 && loop.gamma == 1.0) {
+        next = plain;  // the update would return q_hat bit for bit
+        value = merit(next);
+      } else {
+        next = chebyshev_update(plain, x, previous, values.omega, loop.gamma);
+        hold_pinned(next, held, inv_mass);
+        value = merit(next);
+        if (restart_needed(g, value, kRestartSlack)) {
+          next = plain;
+          value = merit(next);
+          values.restarted = true;
+          ++report.restarts;
+          schedule.restart();
+        }
+      }
+      previous.swap(x);
+      x.swap(next);
+    } else {
+      x.swap(plain);
+      if (tracked) value = evaluate(x);
+    }
+    report.iterations_done = k;
+    if (!all_finite(x)) {
+      report.problem = loop.name + ": non-finite positions after " + loop.unit + " " + std::to_string(k);
+      return report;
+    }
+    if (!tracked) continue;
+    values.objective = value;
+    stopped = record(values);
+    const bool small = loop.tolerance > 0.0 && decrease_below(g, value, loop.tolerance);
+    g = value;
+    if (small) {
+      report.converged = true;
+      break;
+    }
+  }
+  report.objective = std::isnan(g) ? merit(x) : g;
+  return report;
+}
+
+double estimate_plain_rho(Eigen::Matrix3Xd x, const PlainIteration& plain_iteration, int iterations, double scale) {
+  if (iterations < 2) throw std::invalid_argument("estimate_rho: needs at least 2 iterations");
+  std::vector<double> norms;
+  Eigen::Matrix3Xd next(3, x.cols());
+  for (int k = 0; k < iterations; ++k) {
+    plain_iteration(x, next);
+    const double length = (next - x).norm();
+    if (!std::isfinite(length) || length <= 1e-12 * scale) break;  // round-off: no rate left to measure
+    norms.push_back(length);
+    x.swap(next);
+  }
+  if (norms.size() < 2) return 0.0;
+  return estimate_spectral_radius(norms);
+}
+
 // ------------------------------------------------------------------ the solver
 
 Solver::Solver(Eigen::VectorXd inv_mass, std::vector<Spring> springs, double dt)
@@ -216,87 +309,28 @@ StepReport Solver::minimise(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Meth
     report.problem = setup_problem_;
     return report;
   }
-  return method == Method::kPdLbfgs ? lbfgs_pd(x, y, settings, on_iteration)
-                                    : chebyshev_pd(x, y, method, settings, on_iteration);
+  if (method == Method::kPdLbfgs) return lbfgs_pd(x, y, settings, on_iteration);
+  // Plain PD (method kPd) or Chebyshev-accelerated PD on lab 06's objective g.
+  const lab06::Problem& problem = *problem_;
+  IterateCallback each = nullptr;
+  if (on_iteration) {
+    each = [&](const IterationRecord& record, const Eigen::Matrix3Xd& q) {
+      IterationRecord copy = record;
+      copy.max_strain = strain_stats(q, problem.springs).max;
+      return on_iteration(copy);
+    };
+  }
+  return accelerated_iterations(x, y, inv_mass_, pd_iteration(y),
+                                [&](const Eigen::Matrix3Xd& q) { return lab06::objective(problem, q, y); },
+                                {settings.iterations, settings.tolerance, method == Method::kPdChebyshev, settings.rho,
+                                 settings.gamma, settings.delay, method_name(method), "iteration"},
+                                each);
 }
 
-// Plain PD (method kPd) or Chebyshev-accelerated PD: the objective is
-// evaluated every iteration for the restart rule (plain PD: only when a
-// record or the tolerance needs it).
-StepReport Solver::chebyshev_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Method method,
-                                const Settings& settings, const IterationCallback& on_iteration) {
-  const lab06::Problem& problem = *problem_;
-  const bool accelerated = method == Method::kPdChebyshev;
-  const bool tracked = accelerated || settings.tolerance > 0.0 || on_iteration;
-  StepReport report;
-  Clock clock;
-  auto record = [&](const IterationRecord& values) {
-    if (!on_iteration) return false;
-    const Timer timer;
-    IterationRecord copy = values;
-    copy.seconds = clock.seconds();
-    copy.max_strain = strain_stats(x, problem.springs).max;
-    const bool stop = on_iteration(copy);
-    clock.excluded += timer.seconds();
-    return stop;
+PlainIteration Solver::pd_iteration(const Eigen::Matrix3Xd& y) {
+  return [this, &y](const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& plain) {
+    plain = lab06::global_step(*problem_, factor_, y, lab06::local_step(x, problem_->springs));
   };
-  double g = std::numeric_limits<double>::quiet_NaN();
-  bool stopped = false;
-  if (tracked) {
-    g = lab06::objective(problem, x, y);
-    stopped = record({0, g, 0.0, 1.0, false, 0.0});
-  }
-  Schedule schedule{settings.rho, settings.delay};
-  Eigen::Matrix3Xd previous = x;
-  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
-    const Eigen::Matrix3Xd plain = lab06::global_step(problem, factor_, y, lab06::local_step(x, problem.springs));
-    IterationRecord values{k, 0.0, 0.0, 1.0, false, 0.0};
-    Eigen::Matrix3Xd next;
-    double value = std::numeric_limits<double>::quiet_NaN();
-    if (accelerated) {
-      values.omega = schedule.next(k);
-      if (values.omega == 1.0 && settings.gamma == 1.0) {
-        next = plain;  // the update would return q_hat bit for bit
-        value = lab06::objective(problem, next, y);
-      } else {
-        next = chebyshev_update(plain, x, previous, values.omega, settings.gamma);
-        hold_pinned(next, y, inv_mass_);
-        value = lab06::objective(problem, next, y);
-        if (restart_needed(g, value, kRestartSlack)) {
-          next = plain;
-          value = lab06::objective(problem, next, y);
-          values.restarted = true;
-          ++report.restarts;
-          schedule.restart();
-        }
-      }
-    } else {
-      next = plain;
-      if (tracked) {
-        const Timer timer;
-        value = lab06::objective(problem, next, y);
-        if (settings.tolerance == 0.0) clock.excluded += timer.seconds();
-      }
-    }
-    previous.swap(x);
-    x.swap(next);
-    report.iterations_done = k;
-    if (!all_finite(x)) {
-      report.problem = std::string(method_name(method)) + ": non-finite positions after iteration " + std::to_string(k);
-      return report;
-    }
-    if (!tracked) continue;
-    values.objective = value;
-    stopped = record(values);
-    const bool small = settings.tolerance > 0.0 && decrease_below(g, value, settings.tolerance);
-    g = value;
-    if (small) {
-      report.converged = true;
-      break;
-    }
-  }
-  report.objective = std::isnan(g) ? lab06::objective(problem, x, y) : g;
-  return report;
 }
 
 // L-BFGS on PD's matrix (Liu et al. 2017): the direction of the two-loop
@@ -411,73 +445,24 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
 // Chebyshev acceleration of the Jacobi sweeps.
 StepReport Solver::pbd(Particles& particles, Method method, const Settings& settings,
                        const IterationCallback& on_iteration) {
-  if (!constraints_) constraints_ = lab04::make_constraint_set(inv_mass_.size(), springs_);
-  const lab04::ConstraintSet& constraints = *constraints_;
-  StepReport report;
-  Clock clock;
   const Timer timer;
-  // lab 04's prediction, operation for operation (a plain run is its step bit for bit).
-  Eigen::Matrix3Xd p = particles.x;
-  for (Eigen::Index i = 0; i < p.cols(); ++i) {
-    if (inv_mass_[i] > 0.0) {
-      const Eigen::Vector3d velocity = particles.v.col(i) + dt_ * settings.gravity;
-      p.col(i) += dt_ * velocity;
-    }
-  }
+  Eigen::Matrix3Xd p = pbd_prediction(particles, settings.gravity);
   const Eigen::Matrix3Xd held = p;
-  const bool accelerated = method == Method::kJacobiChebyshev;
-  auto record = [&](const IterationRecord& values) {
-    if (!on_iteration) return false;
-    const Timer timer_record;
-    IterationRecord copy = values;
-    copy.seconds = clock.seconds();
-    copy.max_strain = strain_stats(p, springs_).max;
-    if (!accelerated) copy.objective = strain_merit(p, springs_);
-    const bool stop = on_iteration(copy);
-    clock.excluded += timer_record.seconds();
-    return stop;
-  };
-  double merit = accelerated ? strain_merit(p, springs_) : 0.0;
-  bool stopped = record({0, merit, 0.0, 1.0, false, 0.0});
-  Schedule schedule{settings.rho, settings.delay};
-  Eigen::Matrix3Xd previous = p, plain(3, p.cols());
-  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
-    IterationRecord values{k, 0.0, 0.0, 1.0, false, 0.0};
-    if (method == Method::kGaussSeidel) {
-      lab02::gauss_seidel_sweep(p, inv_mass_, springs_, constraints.order);
-    } else {
-      lab03::jacobi_sweep(p, plain, inv_mass_, springs_, constraints.incidence, 1.0, lab03::Averaging::kByCount);
-      if (!accelerated) {
-        p.swap(plain);
-      } else {
-        values.omega = schedule.next(k);
-        Eigen::Matrix3Xd next = plain;
-        if (values.omega != 1.0 || settings.gamma != 1.0) {
-          next = chebyshev_update(plain, p, previous, values.omega, settings.gamma);
-          hold_pinned(next, held, inv_mass_);
-        }
-        double value = strain_merit(next, springs_);
-        if (restart_needed(merit, value, kRestartSlack) && (values.omega != 1.0 || settings.gamma != 1.0)) {
-          next = plain;
-          value = strain_merit(next, springs_);
-          values.restarted = true;
-          ++report.restarts;
-          schedule.restart();
-        }
-        merit = value;
-        values.objective = value;
-        previous.swap(p);
-        p.swap(next);
-      }
-    }
-    report.iterations_done = k;
-    if (!all_finite(p)) {
-      report.problem = std::string(method_name(method)) + ": non-finite positions after sweep " + std::to_string(k);
-      return report;
-    }
-    stopped = record(values);
+  IterateCallback each = nullptr;
+  if (on_iteration) {
+    each = [&](const IterationRecord& record, const Eigen::Matrix3Xd& q) {
+      IterationRecord copy = record;
+      copy.max_strain = strain_stats(q, springs_).max;
+      return on_iteration(copy);
+    };
   }
-  report.objective = strain_merit(p, springs_);
+  // PBD has no objective, hence no tolerance: the merit judges the restarts alone.
+  StepReport report = accelerated_iterations(
+      p, held, inv_mass_, pbd_iteration(method), [&](const Eigen::Matrix3Xd& q) { return strain_merit(q, springs_); },
+      {settings.iterations, 0.0, method == Method::kJacobiChebyshev, settings.rho, settings.gamma, settings.delay,
+       method_name(method), "sweep"},
+      each);
+  if (!report.problem.empty()) return report;
   particles.v = (p - particles.x) / dt_;
   particles.x = p;
   report.seconds = timer.seconds();
@@ -486,43 +471,40 @@ StepReport Solver::pbd(Particles& particles, Method method, const Settings& sett
 
 double Solver::estimate_rho(const Particles& start, Method method, const Settings& settings, int iterations) {
   if (iterations < 2) throw std::invalid_argument("estimate_rho: needs at least 2 iterations");
-  std::vector<double> norms;
-  // The update lengths; stop before round-off (a length below 1e-12 of the
-  // positions' size would measure noise, not the rate).
   const double scale = std::max(start.x.cwiseAbs().maxCoeff(), 1e-300);
-  const Particles& particles = start;
   if (minimises_objective(method)) {
     require_pd();
     if (!setup_problem_.empty()) return 0.0;
-    const Eigen::Matrix3Xd y = lab06::predict(particles, settings.gravity, dt_);
-    Eigen::Matrix3Xd x = y;
-    for (int k = 0; k < iterations; ++k) {
-      const Eigen::Matrix3Xd next = lab06::global_step(*problem_, factor_, y, lab06::local_step(x, problem_->springs));
-      const double length = (next - x).norm();
-      if (!std::isfinite(length) || length <= 1e-12 * scale) break;
-      norms.push_back(length);
-      x = next;
-    }
-  } else {
-    if (!constraints_) constraints_ = lab04::make_constraint_set(inv_mass_.size(), springs_);
-    Eigen::Matrix3Xd p = particles.x;
-    for (Eigen::Index i = 0; i < p.cols(); ++i) {
-      if (inv_mass_[i] > 0.0) {
-        const Eigen::Vector3d velocity = particles.v.col(i) + dt_ * settings.gravity;
-        p.col(i) += dt_ * velocity;
-      }
-    }
-    Eigen::Matrix3Xd next(3, p.cols());
-    for (int k = 0; k < iterations; ++k) {
-      lab03::jacobi_sweep(p, next, inv_mass_, springs_, constraints_->incidence, 1.0, lab03::Averaging::kByCount);
-      const double length = (next - p).norm();
-      if (!std::isfinite(length) || length <= 1e-12 * scale) break;
-      norms.push_back(length);
-      p.swap(next);
+    const Eigen::Matrix3Xd y = lab06::predict(start, settings.gravity, dt_);
+    return estimate_plain_rho(y, pd_iteration(y), iterations, scale);
+  }
+  return estimate_plain_rho(pbd_prediction(start, settings.gravity), pbd_iteration(Method::kJacobi), iterations, scale);
+}
+
+// lab 04's prediction, operation for operation (a plain run is its step bit for bit).
+Eigen::Matrix3Xd Solver::pbd_prediction(const Particles& particles, const Eigen::Vector3d& gravity) const {
+  Eigen::Matrix3Xd p = particles.x;
+  for (Eigen::Index i = 0; i < p.cols(); ++i) {
+    if (inv_mass_[i] > 0.0) {
+      const Eigen::Vector3d velocity = particles.v.col(i) + dt_ * gravity;
+      p.col(i) += dt_ * velocity;
     }
   }
-  if (norms.size() < 2) return 0.0;
-  return estimate_spectral_radius(norms);
+  return p;
+}
+
+PlainIteration Solver::pbd_iteration(Method method) {
+  if (!constraints_) constraints_ = lab04::make_constraint_set(inv_mass_.size(), springs_);
+  const lab04::ConstraintSet& constraints = *constraints_;
+  if (method == Method::kGaussSeidel) {
+    return [this, &constraints](const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& plain) {
+      plain = x;
+      lab02::gauss_seidel_sweep(plain, inv_mass_, springs_, constraints.order);
+    };
+  }
+  return [this, &constraints](const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& plain) {
+    lab03::jacobi_sweep(x, plain, inv_mass_, springs_, constraints.incidence, 1.0, lab03::Averaging::kByCount);
+  };
 }
 
 // ------------------------------------------------------------------ a run
@@ -539,27 +521,14 @@ double total_energy(const Particles& particles, const std::vector<Spring>& sprin
 }  // namespace
 
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step, const RunIterationCallback& on_iteration) {
+                    const StepCallback& on_step, const RunIterationCallback& on_iteration, const FrameOutput& output) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
   const std::vector<Spring>& springs = solver.springs();
   const bool elastic = minimises_objective(method);
   RunResult result;
   StepRecord record;
-  record.strain = strain_stats(particles.x, springs);
-  record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
-  result.energy_start = result.energy_end = record.total_energy;
-  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
-                       (elastic ? lab06::spring_energy(particles.x, springs) : 0.0);
-  record.problem = health_problem(particles, record.strain);
-  if (on_step) on_step(record, particles);
-  if (!record.problem.empty()) {
-    result.problem = record.problem;
-    result.problem_step = 0;
-    return result;
-  }
-  for (int s = 1; s <= steps; ++s) {
-    record = StepRecord{};
-    record.step = s;
+  StepReport report;
+  auto step = [&](int s) {
     IterationCallback each = nullptr;
     if (on_iteration) {
       each = [&](const IterationRecord& iteration) {
@@ -567,26 +536,41 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
         return false;
       };
     }
-    record.report = solver.step(particles, method, settings, each);
-    result.seconds += record.report.seconds;
-    result.iterations_done += record.report.iterations_done;
-    result.restarts += record.report.restarts;
-    result.failed_line_searches += record.report.failed_line_searches;
-    result.steps_done = s;
+    report = solver.step(particles, method, settings, each);
+    result.iterations_done += report.iterations_done;
+    result.restarts += report.restarts;
+    result.failed_line_searches += report.failed_line_searches;
+    return StepVerdict{report.problem, true, report.seconds};
+  };
+  auto measured = [&](int s, double) {
+    record = StepRecord{};
+    record.step = s;
+    if (s > 0) record.report = report;
     record.strain = strain_stats(particles.x, springs);
     record.total_energy = total_energy(particles, springs, settings.gravity, elastic);
-    result.energy_end = record.total_energy;
-    record.problem = record.report.problem;
-    if (record.problem.empty()) record.problem = health_problem(particles, record.strain);
-    if (record.problem.empty()) record.problem = energy_rise_problem(result.energy_end - result.energy_start, scale);
-    if (on_step) on_step(record, particles);
-    if (!record.problem.empty()) {
-      result.problem = record.problem;
-      result.problem_step = s;
-      return result;
-    }
-  }
+    return FrameMeasure{record.strain, record.total_energy, {},
+                        {record.report.objective, static_cast<long long>(record.report.iterations_done),
+                         static_cast<long long>(record.report.converged ? 1 : 0),
+                         static_cast<long long>(record.report.restarts),
+                         static_cast<long long>(record.report.failed_line_searches), record.report.seconds,
+                         record.strain.max, record.strain.rms, record.total_energy},
+                        {}};
+  };
+  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
+                       (elastic ? lab06::spring_energy(particles.x, springs) : 0.0);
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  const FrameLoopResult run = run_frame_loop(particles, step, measured, frame_plan(steps, solver.dt(), scale),
+                                             with_index, record_hook(record, on_step));
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
   return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"objective", "iterations", "converged", "restarts", "failed_line_searches", "seconds", "max_strain",
+          "rms_strain", "total_energy"};
 }
 
 }  // namespace cl::lab11

@@ -3,7 +3,8 @@
 // acceleration.h, built on the earlier labs' code through their headers:
 // lab 06's local step, global step, system matrix, objective and Newton step;
 // lab 03's Jacobi sweep and lab 02's Gauss-Seidel sweep inside lab 04's PBD
-// step. It owns the state; the functions of acceleration.h stay stateless.
+// step; and the loop over a scene's steps on common/frame_loop.h. It owns the
+// state; the functions of acceleration.h stay stateless.
 #include <functional>
 #include <memory>
 #include <optional>
@@ -15,6 +16,7 @@
 #include "../lab06_projective_dynamics/simulation.h"
 #include "acceleration.h"
 #include "common/constraints.h"
+#include "common/frame_loop.h"
 #include "common/particles.h"
 #include "common/sparse.h"
 #include "pbd.h"
@@ -64,6 +66,56 @@ struct StepReport {
 // The relative slack of the restart rule: rises within round-off are not restarts.
 constexpr double kRestartSlack = 1e-13;
 
+// ------------------------------------------------------------------ the accelerated loop
+
+// The loop every Chebyshev-accelerated method of labs 11 and 12 runs (Wang
+// 2015: PD here, Jacobi PBD here, VBD in lab 12), around the plain iteration
+// it accelerates. Iteration k: q̂ = F(x); with `accelerated` the weight ω
+// (ω = 1 for the first `delay` iterations, then chebyshev_weight with j
+// counted from iteration `delay` or from the last restart) mixes q̂, x and the
+// iterate before it by chebyshev_update (pinned columns put back from
+// `held`); restart_needed on the merit (slack kRestartSlack) rejects the mix
+// for q̂ and restarts the weights. Without `accelerated` the iterate is q̂.
+struct AcceleratedLoop {
+  int iterations = 0;        // K >= 0
+  double tolerance = 0.0;    // stop once the merit's relative decrease falls below it (lab 06's rule; 0: all K)
+  bool accelerated = false;  // Chebyshev's weights (false: the plain iteration)
+  double rho = 0.0;          // the weights' spectral radius, [0, 1)
+  double gamma = 1.0;        // the under-relaxation, (0, 2)
+  int delay = 1;             // S >= 1
+  std::string name;          // the method, for the problem's text
+  std::string unit = "iteration";  // what one iteration is called there ("sweep")
+};
+
+// x ↦ F(x): the plain iterate into `plain` (resized; it does not alias x).
+using PlainIteration = std::function<void(const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& plain)>;
+// The merit that the restart rule and the tolerance judge (PD and VBD: g, J; PBD: strain_merit).
+using Merit = std::function<double(const Eigen::Matrix3Xd& x)>;
+// Called with each iterate's record (iteration 0: the start; max_strain left
+// 0) and the iterate, which it may measure: its time is not counted in the
+// records' seconds. Returns true to end the loop at this iterate.
+using IterateCallback = std::function<bool(const IterationRecord& record, const Eigen::Matrix3Xd& x)>;
+
+// Runs the loop from x (3 × n, its pinned columns those of `held`; inv_mass: n
+// entries) and leaves the last iterate in x. The merit is evaluated every
+// iteration that the weights, the tolerance or a record need (for the plain
+// iteration's records outside the measured time). A non-finite iterate ends
+// the loop with the problem "<name>: non-finite positions after <unit> k".
+// The report's objective is the merit at x (not set after a problem); its
+// seconds are left to the caller.
+StepReport accelerated_iterations(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& held, const Eigen::VectorXd& inv_mass,
+                                  const PlainIteration& plain_iteration, const Merit& merit,
+                                  const AcceleratedLoop& loop, const IterateCallback& on_iterate = nullptr);
+
+// ρ of a plain iteration, measured from x: the update lengths ‖F(q) − q‖ of up
+// to `iterations` iterations, ending before one that is not finite or at most
+// 1e-12 · scale (round-off: noise, not the rate), given to
+// estimate_spectral_radius; 0 when fewer than 2 were measured. Throws
+// std::invalid_argument for iterations < 2.
+double estimate_plain_rho(Eigen::Matrix3Xd x, const PlainIteration& plain_iteration, int iterations, double scale);
+
+// ------------------------------------------------------------------ the solver
+
 // One scene's solver. The PD pieces (lab 06's Problem, A factored once) are
 // made on the first step of a PD-family method; the constraint set (lab 04) on
 // the first PBD step.
@@ -97,8 +149,9 @@ class Solver {
 
  private:
   void require_pd();
-  StepReport chebyshev_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Method method, const Settings& settings,
-                          const IterationCallback& on_iteration);
+  PlainIteration pd_iteration(const Eigen::Matrix3Xd& y);  // one local/global iteration of lab 06 for y
+  Eigen::Matrix3Xd pbd_prediction(const Particles& particles, const Eigen::Vector3d& gravity) const;
+  PlainIteration pbd_iteration(Method method);  // one sweep: Gauss-Seidel (lab 02) or Jacobi (lab 03)
   StepReport lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const Settings& settings,
                       const IterationCallback& on_iteration);
   StepReport pbd(Particles& particles, Method method, const Settings& settings,
@@ -146,10 +199,17 @@ struct RunResult {
   int problem_step = -1;
 };
 
-// Runs `steps` steps; stops at the first failed or unhealthy step
-// (common/health.h), or one whose total energy rose more than the scene's
-// energy scale above its start.
+// Runs `steps` steps in common/frame_loop.h's loop: it stops at the first
+// failed or unhealthy step (common/health.h), or one whose total energy rose
+// more than the scene's energy scale (plus, for the PD family, its initial
+// elastic energy) above its start, and writes the per-step CSV of
+// step_columns() and the trajectory when `output` asks for them.
 RunResult run_steps(Particles& particles, Solver& solver, Method method, const Settings& settings, int steps,
-                    const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr);
+                    const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr,
+                    const FrameOutput& output = {});
+
+// objective, iterations, converged, restarts, failed_line_searches, seconds,
+// max_strain, rms_strain, total_energy.
+std::vector<std::string> step_columns();
 
 }  // namespace cl::lab11

@@ -1,14 +1,13 @@
 // lab11_acceleration: projective dynamics accelerated by Chebyshev (Wang 2015)
 // and by L-BFGS on PD's matrix (Liu et al. 2017); Jacobi PBD by Chebyshev.
-//   default        run the scene's steps: iterations.csv (every iteration of
-//                  every step) and the run summary
+//   default        run the scene's steps: per_step.csv, iterations.csv (every
+//                  iteration of every step) and the run summary
 //   --convergence  one step from the scene's start, to the minimum:
 //                  convergence.csv (objective_error = (g − g*)/g*, g* lab 06's
 //                  Newton minimum; max_strain for PBD) and a table of the
 //                  iterations and seconds to each target
 #include <cmath>
 #include <cstdio>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,7 +17,6 @@
 #include "common/driver.h"
 #include "common/output.h"
 #include "common/summary.h"
-#include "common/trajectory.h"
 
 namespace {
 
@@ -74,21 +72,11 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
     table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.max_strain,
                    r.omega, static_cast<long long>(r.restarted), r.seconds});
   };
-  // Every due step (and the last, and one that stopped the run) for ./course view.
-  std::optional<cl::TrajectoryWriter> trajectory;
-  if (options.frames > 0) {
-    trajectory.emplace(options.out, options.frames, scene, cl::TrajectoryIdentity{kLab, options.method});
-  }
-  const cl::lab11::StepCallback on_step = [&](const cl::lab11::StepRecord& r, const cl::Particles& state) {
-    if (r.step % options.frames == 0 || r.step == scene.steps || !r.problem.empty()) {
-      trajectory->add(r.step, r.step * scene.dt, state.x, r.total_energy, r.problem.empty() ? "ok" : r.problem);
-    }
-  };
+  const cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab11::step_columns(), options.method);
   cl::Particles& particles = scene.particles;
-  const cl::lab11::RunResult result =
-      cl::lab11::run_steps(particles, solver, method, settings, scene.steps, trajectory ? on_step : nullptr,
-                           options.out.empty() ? nullptr : on_iteration);
-  if (trajectory) trajectory->finish();
+  const cl::lab11::RunResult result = cl::lab11::run_steps(particles, solver, method, settings, scene.steps, nullptr,
+                                                           options.out.empty() ? nullptr : on_iteration, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
   const bool chebyshev = method == Method::kPdChebyshev || method == Method::kJacobiChebyshev;
   std::printf("%s: scene %s, %s, K = %d, rho %.6f%s, gamma %g, delay %d, history %d, %d steps of %.4g s\n", kLab,

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "acceleration.h"
+#include "accelerated.h"
 #include "common/health.h"
 #include "common/metrics.h"
 #include "common/timer.h"
@@ -15,12 +15,6 @@
 namespace cl::lab12 {
 
 namespace {
-
-// lab 06's tolerance rule: the relative decrease fell below tol.
-bool decrease_below(double previous, double current, double tolerance) {
-  if (!(previous > 0.0)) return true;
-  return previous - current < tolerance * previous;
-}
 
 void check(const Settings& settings) {
   if (settings.iterations < 0) throw std::invalid_argument("iterations must be >= 0");
@@ -32,16 +26,6 @@ void check(const Settings& settings) {
   }
   if (!settings.gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
 }
-
-// Wall time of the method, without what is spent only for the records.
-struct Clock {
-  Timer timer;
-  double excluded = 0.0;
-  double seconds() const { return timer.seconds() - excluded; }
-};
-
-// The relative slack of lab 11's restart rule.
-constexpr double kRestartSlack = 1e-13;
 
 }  // namespace
 
@@ -170,101 +154,39 @@ StepReport Solver::minimise(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, Meth
   check(settings);
   const Eigen::Index n = problem_.inv_mass.size();
   if (x.cols() != n || y.cols() != n) throw std::invalid_argument("Solver::minimise: x and y need one column per particle");
-  const bool accelerated = method == Method::kVbdChebyshev && settings.rho > 0.0;
-  const bool tracked = accelerated || settings.tolerance > 0.0 || on_iteration;
-  StepReport report;
-  Clock clock;
-  auto record = [&](const IterationRecord& values) {
-    if (!on_iteration) return false;
-    const Timer timer;
-    IterationRecord copy = values;
-    copy.seconds = clock.seconds();
-    const bool stop = on_iteration(copy);
-    clock.excluded += timer.seconds();
-    return stop;
-  };
-  double g = std::numeric_limits<double>::quiet_NaN();
-  bool stopped = false;
-  if (tracked) {
-    const Timer timer;
-    g = lab06::objective(problem_, x, y);
-    if (!accelerated && settings.tolerance == 0.0) clock.excluded += timer.seconds();
-    stopped = record({0, g, 1.0, false, 0.0});
+  // lab 11's loop around the sweep: g judges the restarts and the tolerance.
+  lab11::IterateCallback each = nullptr;
+  if (on_iteration) {
+    each = [&](const lab11::IterationRecord& r, const Eigen::Matrix3Xd&) {
+      return on_iteration({r.iteration, r.objective, r.restarted ? 1.0 : r.omega, r.restarted, r.seconds});
+    };
   }
-  int count = 0;  // Chebyshev: j of this iteration since the start or the last restart
-  double omega = 1.0;
-  Eigen::Matrix3Xd previous = x, plain;
-  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+  const lab11::StepReport done = lab11::accelerated_iterations(
+      x, y, problem_.inv_mass, sweep(y), [&](const Eigen::Matrix3Xd& q) { return lab06::objective(problem_, q, y); },
+      {settings.iterations, settings.tolerance, method == Method::kVbdChebyshev && settings.rho > 0.0, settings.rho,
+       1.0, 1, method_name(method), "sweep"},
+      each);
+  StepReport report;
+  report.iterations_done = done.iterations_done;
+  report.objective = done.objective;
+  report.restarts = done.restarts;
+  report.converged = done.converged;
+  report.problem = done.problem;
+  return report;
+}
+
+lab11::PlainIteration Solver::sweep(const Eigen::Matrix3Xd& y) const {
+  return [this, &y](const Eigen::Matrix3Xd& x, Eigen::Matrix3Xd& plain) {
     plain = x;
     vbd_sweep(problem_, adjacency_, groups_, y, plain);
-    IterationRecord values{k, 0.0, 1.0, false, 0.0};
-    double value = std::numeric_limits<double>::quiet_NaN();
-    if (accelerated) {
-      ++count;
-      omega = lab11::chebyshev_weight(count, settings.rho, omega);
-      values.omega = omega;
-      Eigen::Matrix3Xd next = plain;
-      if (omega != 1.0) {
-        next = lab11::chebyshev_update(plain, x, previous, omega, 1.0);
-        for (Eigen::Index p = 0; p < n; ++p) {
-          if (!(problem_.inv_mass[p] > 0.0)) next.col(p) = y.col(p);
-        }
-      }
-      value = lab06::objective(problem_, next, y);
-      if (omega != 1.0 && lab11::restart_needed(g, value, kRestartSlack)) {
-        next = plain;
-        value = lab06::objective(problem_, next, y);
-        values.restarted = true;
-        values.omega = 1.0;
-        ++report.restarts;
-        count = 1;
-        omega = 1.0;
-      }
-      previous.swap(x);
-      x.swap(next);
-    } else {
-      x.swap(plain);
-      if (tracked) {
-        const Timer timer;
-        value = lab06::objective(problem_, x, y);
-        if (settings.tolerance == 0.0) clock.excluded += timer.seconds();
-      }
-    }
-    report.iterations_done = k;
-    if (!all_finite(x)) {
-      report.problem = std::string(method_name(method)) + ": non-finite positions after sweep " + std::to_string(k);
-      return report;
-    }
-    if (!tracked) continue;
-    values.objective = value;
-    stopped = record(values);
-    const bool small = settings.tolerance > 0.0 && decrease_below(g, value, settings.tolerance);
-    g = value;
-    if (small) {
-      report.converged = true;
-      break;
-    }
-  }
-  report.objective = std::isnan(g) ? lab06::objective(problem_, x, y) : g;
-  return report;
+  };
 }
 
 double Solver::estimate_rho(const Particles& start, const Settings& settings, int iterations) const {
   if (iterations < 2) throw std::invalid_argument("estimate_rho: needs at least 2 iterations");
   const double scale = std::max(start.x.cwiseAbs().maxCoeff(), 1e-300);
   const Eigen::Matrix3Xd y = lab06::predict(start, settings.gravity, problem_.dt);
-  Eigen::Matrix3Xd x = y, next;
-  std::vector<double> norms;
-  for (int k = 0; k < iterations; ++k) {
-    next = x;
-    vbd_sweep(problem_, adjacency_, groups_, y, next);
-    const double length = (next - x).norm();
-    if (!std::isfinite(length) || length <= 1e-12 * scale) break;  // round-off: no rate left to measure
-    norms.push_back(length);
-    x.swap(next);
-  }
-  if (norms.size() < 2) return 0.0;
-  return lab11::estimate_spectral_radius(norms);
+  return lab11::estimate_plain_rho(y, sweep(y), iterations, scale);
 }
 
 // ------------------------------------------------------------------ a run

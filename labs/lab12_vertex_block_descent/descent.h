@@ -3,7 +3,8 @@
 // four functions of vbd.h, K sweeps), with the initial guesses of Chen et al.
 // (2024: plain inertia y, or the paper's adaptive one) and, optionally, the
 // Chebyshev acceleration of lab 11 (Wang 2015; Chen et al. §3.8) applied
-// after each sweep; and the loop over a scene's steps on common/frame_loop.h.
+// after each sweep by lab 11's accelerated loop (accelerated.h); and the loop
+// over a scene's steps on common/frame_loop.h.
 // It owns the state; the functions of vbd.h stay stateless.
 #include <functional>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "../lab06_projective_dynamics/simulation.h"
+#include "accelerated.h"
 #include "common/frame_loop.h"
 #include "common/particles.h"
 #include "vbd.h"
@@ -93,6 +95,8 @@ class Solver {
   const std::vector<std::vector<int>>& groups() const { return groups_; }
 
  private:
+  lab11::PlainIteration sweep(const Eigen::Matrix3Xd& y) const;  // one vbd_sweep for the prediction y
+
   lab06::Problem problem_;
   Adjacency adjacency_;
   std::vector<int> colours_;
