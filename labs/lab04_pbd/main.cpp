@@ -78,8 +78,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps,
               scene.dt / lab.substeps, scene.dt, scene.steps);
   if (diverged) {
-    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
-                result.problem_frame * scene.dt, result.problem.c_str());
+    cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);
   } else {
     std::printf("  final:   max strain %.3e  rms %.3e\n", strain.max, strain.rms);
     if (result.windows_done > 0) {
@@ -90,8 +89,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       }
       std::printf("\n");
     }
-    std::printf("  energy:  kinetic %.4e J  potential %.4e J  total %.6e J (start %.6e J)\n", kinetic, potential,
-                kinetic + potential, result.energy_start);
+    cl::print_energies("energy:  ", kinetic, potential, std::nullopt, result.energy_start);
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
@@ -126,13 +124,6 @@ struct SweepRun {
   int iterations = 0;
   cl::lab04::RunResult result;
 };
-
-std::string status_of(const cl::lab04::RunResult& result) {
-  if (!result.problem.empty()) {
-    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
-  }
-  return result.settled ? "settled" : "not settled";
-}
 
 // Runs every scene at every (substeps, iterations) point until it settles (or
 // for --steps frames at most); one CSV row per run. The runs are independent,
@@ -181,31 +172,29 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
   for (const SweepRun& run : runs) {
     const cl::Scene& scene = scenes[run.scene];
     const cl::lab04::RunResult& result = run.result;
+    const std::string status = cl::settle_status(result.problem, result.problem_frame, result.settled);
     const bool ok = result.problem.empty();
     const bool measured = ok && result.windows_done > 0;
     const bool energy_known = ok && result.frames_done >= cl::frames_in(lab.energy_seconds, scene.dt);
-    auto value = [](bool known, double number) -> cl::CsvCell {
-      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
-    };
     const double window_seconds = cl::frames_in(lab.window_seconds, scene.dt) * scene.dt;
     const double energy_seconds = cl::frames_in(lab.energy_seconds, scene.dt) * scene.dt;
     table.add_row({scene.name, static_cast<long long>(scene.grid_nx), static_cast<long long>(scene.grid_ny),
                    static_cast<long long>(scene.particles.size()), static_cast<long long>(scene.springs.size()),
                    options.method, scene.dt, static_cast<long long>(run.substeps),
                    static_cast<long long>(run.iterations), static_cast<long long>(result.frames_done),
-                   result.frames_done * scene.dt, window_seconds, value(measured, result.window_max_strain),
-                   value(measured, result.window_rms_strain),
-                   value(measured && result.window_spread >= 0.0, result.window_spread), result.energy_start,
-                   energy_seconds, value(energy_known, result.energy_at_mark), value(ok, result.energy_end),
-                   result.max_energy_rise, result.seconds, status_of(result)});
+                   result.frames_done * scene.dt, window_seconds, cl::cell_if(measured, result.window_max_strain),
+                   cl::cell_if(measured, result.window_rms_strain),
+                   cl::cell_if(measured && result.window_spread >= 0.0, result.window_spread), result.energy_start,
+                   energy_seconds, cl::cell_if(energy_known, result.energy_at_mark), cl::cell_if(ok, result.energy_end),
+                   result.max_energy_rise, result.seconds, status});
     if (measured) {
       std::printf("%-12s %8d %10d %12.4e %12.4e %8.1e %8.2f %13.4e %9.3f  %s\n", scene.name.c_str(), run.substeps,
                   run.iterations, result.window_max_strain, result.window_rms_strain, result.window_spread,
                   result.frames_done * scene.dt, energy_known ? result.energy_at_mark - result.energy_start : 0.0,
-                  result.seconds, status_of(result).c_str());
+                  result.seconds, status.c_str());
     } else {
       std::printf("%-12s %8d %10d  %s\n", scene.name.c_str(), run.substeps, run.iterations,
-                  ok ? "too short for one window" : status_of(result).c_str());
+                  ok ? "too short for one window" : status.c_str());
     }
   }
   if (!options.out.empty()) table.write(cl::join_path(options.out, csv_name));
@@ -223,8 +212,8 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
     }
     return run_one(options, lab);
   }
-  if (options.frames > 0) throw cl::InputError("--frames: not with a sweep (run one configuration instead)");
-  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
+  cl::refuse_run_flags(options, "not with a sweep (run one configuration instead)",
+                       "a sweep writes a CSV, not a run summary");
   std::vector<std::pair<int, int>> points;  // (substeps, iterations)
   if (!lab.sweep_iterations.empty()) {
     for (const int k : lab.sweep_iterations) points.emplace_back(lab.substeps, k);
@@ -247,11 +236,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
                "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "curtain-16";
-  options.method = "gauss-seidel";
-  options.methods = {"gauss-seidel", "jacobi"};
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("curtain-16", "gauss-seidel", {"gauss-seidel", "jacobi"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);

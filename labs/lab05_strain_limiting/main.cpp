@@ -117,13 +117,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               cl::describe(scene).c_str(), cl::lab05::limit_name(limit), lab.sigma_min, lab.sigma_max,
               options.iterations, scene.dt, scene.steps);
   if (diverged) {
-    std::printf("  UNSTABLE at step %d (t = %.4g s): %s\n", result.problem_step, result.problem_step * scene.dt,
-                result.problem.c_str());
+    cl::print_stopped("UNSTABLE", "step", result.problem_step, scene.dt, result.problem);
   } else {
     std::printf("  final:      strain (l/L - 1) from %+.4e to %+.4e\n", strain.min, strain.max);
     std::printf("  whole run:  strain from %+.4e to %+.4e\n", result.min_strain, result.max_strain);
-    std::printf("  energy:     kinetic %.4e J  potential %.4e J  elastic %.4e J  total %.6e J (start %.6e J)\n",
-                kinetic, potential, elastic, kinetic + potential + elastic, result.energy_start);
+    cl::print_energies("energy:     ", kinetic, potential, elastic, result.energy_start);
   }
   const std::string outside = band_problem(result, limit, lab, options.iterations);
   if (!outside.empty()) std::printf("  WARNING: %s\n", outside.c_str());
@@ -268,38 +266,27 @@ int stability_map(const cl::CommonOptions& options, const LabOptions& lab) {
   }
   // Each cell: the unlimited run, then (if it blew up) the limited one. The
   // cells are independent and shared among the OpenMP threads, most steps first.
-  std::vector<std::size_t> by_cost(cells.size());
-  for (std::size_t c = 0; c < cells.size(); ++c) by_cost[c] = c;
-  std::stable_sort(by_cost.begin(), by_cost.end(),
-                   [&](std::size_t a, std::size_t b) { return cells[a].steps > cells[b].steps; });
-  std::exception_ptr failure;
-  const auto count = static_cast<long>(cells.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long k = 0; k < count; ++k) {
-    MapCell& cell = cells[by_cost[static_cast<std::size_t>(k)]];
-    try {
-      cl::Scene stiff = scene;
-      for (cl::Spring& spring : stiff.springs) spring.stiffness = cell.stiffness;
-      cl::lab05::StepSettings settings = step_settings(stiff, options, lab, Limit::kNone);
-      settings.dt = cell.dt;
-      {
-        cl::Particles particles = stiff.particles;
-        const cl::lab05::LimitedSystem system = cl::lab05::make_limited_system(stiff, Limit::kNone);
-        cell.unlimited = cl::lab05::run_steps(particles, system, settings, cell.steps, true);
-      }
-      if (!cell.unlimited.problem.empty()) {
-        settings.limit = limit;
-        cl::Particles particles = stiff.particles;
-        const cl::lab05::LimitedSystem system = cl::lab05::make_limited_system(stiff, limit);
-        cell.limited = cl::lab05::run_steps(particles, system, settings, cell.steps, false);
-        cell.limited_run = true;
-      }
-    } catch (...) {
-#pragma omp critical(lab05_map_failure)
-      if (!failure) failure = std::current_exception();
+  std::vector<double> steps;
+  for (const MapCell& cell : cells) steps.push_back(cell.steps);
+  cl::run_shared(cl::costliest_first(steps), [&](std::size_t c) {
+    MapCell& cell = cells[c];
+    cl::Scene stiff = scene;
+    for (cl::Spring& spring : stiff.springs) spring.stiffness = cell.stiffness;
+    cl::lab05::StepSettings settings = step_settings(stiff, options, lab, Limit::kNone);
+    settings.dt = cell.dt;
+    {
+      cl::Particles particles = stiff.particles;
+      const cl::lab05::LimitedSystem system = cl::lab05::make_limited_system(stiff, Limit::kNone);
+      cell.unlimited = cl::lab05::run_steps(particles, system, settings, cell.steps, true);
     }
-  }
-  if (failure) std::rethrow_exception(failure);
+    if (!cell.unlimited.problem.empty()) {
+      settings.limit = limit;
+      cl::Particles particles = stiff.particles;
+      const cl::lab05::LimitedSystem system = cl::lab05::make_limited_system(stiff, limit);
+      cell.limited = cl::lab05::run_steps(particles, system, settings, cell.steps, false);
+      cell.limited_run = true;
+    }
+  });
 
   // The explicit step's limit, estimated: Δt ω_max < 2 with ω_max² ≈ 8 k w for
   // a grid node with structural and shear springs (README.md, "Why stiff
@@ -321,9 +308,6 @@ int stability_map(const cl::CommonOptions& options, const LabOptions& lab) {
     bounded += verdict == "bounded by the limiter";
     blew_up += verdict == "blew up";
     band_lost += verdict == "blew up" && cell.limited.problem.empty();
-    auto value = [&](double number) -> cl::CsvCell {
-      return cell.limited_run ? cl::CsvCell{number} : cl::CsvCell{std::string()};
-    };
     table.add_row({scene.name, cl::lab05::limit_name(limit), static_cast<long long>(options.iterations),
                    lab.sigma_min, lab.sigma_max, cell.stiffness, cell.dt,
                    2.0 / std::sqrt(8.0 * cell.stiffness * largest_inv_mass), static_cast<long long>(cell.steps),
@@ -331,8 +315,9 @@ int stability_map(const cl::CommonOptions& options, const LabOptions& lab) {
                    status_of(cell.unlimited),
                    cell.limited_run ? cl::CsvCell{static_cast<long long>(cell.limited.steps_done)}
                                     : cl::CsvCell{std::string()},
-                   value(cell.limited.max_strain), value(cell.limited.min_strain),
-                   value(cell.limited.max_energy_rise),
+                   cl::cell_if(cell.limited_run, cell.limited.max_strain),
+                   cl::cell_if(cell.limited_run, cell.limited.min_strain),
+                   cl::cell_if(cell.limited_run, cell.limited.max_energy_rise),
                    cell.limited_run ? cl::CsvCell{status_of(cell.limited)} : cl::CsvCell{std::string()}, why,
                    cell.unlimited.seconds + cell.limited.seconds});
     char limited_max[32] = "";
@@ -358,12 +343,12 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.stability_map && !lab.compare_limits.empty()) {
     throw cl::InputError("--stability-map: not with --compare-limits (one experiment per run)");
   }
-  if (options.frames > 0 && (lab.stability_map || !lab.compare_limits.empty())) {
-    throw cl::InputError("--frames: only for one run (not with --stability-map or --compare-limits)");
+  if (lab.stability_map || !lab.compare_limits.empty()) {
+    cl::refuse_run_flags(options, "only for one run (not with --stability-map or --compare-limits)", "");
   }
   if (lab.stability_map) return stability_map(options, lab);
   if (!lab.compare_limits.empty()) {
-    if (!options.summary.empty()) throw cl::InputError("--summary: --compare-limits writes CSVs, not a run summary");
+    cl::refuse_run_flags(options, "", "--compare-limits writes CSVs, not a run summary");
     return compare_limits(options, lab);
   }
   return run_one(options, lab);
@@ -376,9 +361,7 @@ int main(int argc, char** argv) {
                "or triangles to [sigma-min, sigma-max] after every step; writes per-step strain and energy and a "
                "summary. Or compares the limiters, or maps stability over stiffness and dt.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "soft-curtain-32";
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("soft-curtain-32");
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);

@@ -100,8 +100,7 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
               scene.dt);
   std::printf("  factorizations: %d (%.3e s)\n", solver.factorizations(), solver.factor_seconds());
   if (diverged) {
-    std::printf("  DIVERGED at step %d (t = %.4g s): %s\n", result.problem_step, result.problem_step * scene.dt,
-                result.problem.c_str());
+    cl::print_stopped("DIVERGED", "step", result.problem_step, scene.dt, result.problem);
   } else {
     // A spring of rest length 0 has no strain: strain_stats counts its length (m).
     const auto zero_rest = std::count_if(scene.springs.begin(), scene.springs.end(),
@@ -188,7 +187,6 @@ Curve measure_step(cl::lab06::Solver& solver, const cl::Particles& start, const 
 }
 
 int run_convergence(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (!options.summary.empty()) throw cl::InputError("--summary: --convergence writes CSV files, not a run summary");
   std::vector<cl::Scene> scenes;
   for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene} : lab.sweep_scenes) {
     scenes.push_back(load(options, lab, name));
@@ -296,10 +294,11 @@ int run_convergence(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (lab.convergence && options.frames > 0) {
-    throw cl::InputError("--frames: only for one run (not with --convergence)");
+  if (lab.convergence) {
+    cl::refuse_run_flags(options, "only for one run (not with --convergence)",
+                         "--convergence writes CSV files, not a run summary");
+    return run_convergence(options, lab);
   }
-  if (lab.convergence) return run_convergence(options, lab);
   if (!lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
   return run_steps(options, lab);
 }
@@ -311,11 +310,7 @@ int main(int argc, char** argv) {
                "writes per-step objective, iterations, time and strain and a summary; or (--convergence) one "
                "step of each method to its minimum and writes the convergence curves.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "pd-curtain-16";
-  options.method = "pd";
-  options.methods = {"pd", "newton"};
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("pd-curtain-16", "pd", {"pd", "newton"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);

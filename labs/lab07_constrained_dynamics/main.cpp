@@ -183,7 +183,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                 lab.regularize, 1.0 / lab.regularize);
   }
   if (stopped) {
-    std::printf("  STOPPED at step %d (t = %.4g s): %s\n", problem_frame, problem_frame * scene.dt, outcome.c_str());
+    cl::print_stopped("STOPPED", "step", problem_frame, scene.dt, outcome);
     if (outcome.rfind("singular", 0) == 0) {
       std::printf("  the state before that step is kept; --regularize EPS (e.g. 1e-9 m/N) makes every hard "
                   "constraint a stiff spring and the system solvable\n");
@@ -201,11 +201,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               lab.stabilize ? " (the solve and the projection)" : "");
   if (lab.stabilize) std::printf("  projection %.3e s per step (%.0f%% of the step)\n", stabilize_seconds / steps_taken,
                                  run.seconds > 0.0 ? 100.0 * stabilize_seconds / run.seconds : 0.0);
-  if (lambda.size() > 0 && lambda.size() <= 4) {
-    std::printf("  multipliers (N):");
-    for (Eigen::Index e = 0; e < lambda.size(); ++e) std::printf(" %.6g", lambda[e]);
-    std::printf("\n");
-  }
+  cl::print_multipliers(lambda);
 
   cl::print_trajectory_note(options, "frame");
   if (!options.summary.empty()) {
@@ -224,12 +220,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["steps_done"] = frames_done;
     summary.extra["step_seconds"] = step_seconds;
     cl::add_total_energy(summary, total_energy(particles, scene, lambda), energy_start);
-    summary.extra["diverged"] = outcome.rfind("diverged", 0) == 0;
-    summary.extra["singular"] = outcome.rfind("singular", 0) == 0;
-    if (stopped) {
-      summary.extra["outcome"] = outcome;
-      summary.extra["stopped_at_step"] = problem_frame;
-    }
+    cl::add_stop_outcome(summary, outcome, "singular", problem_frame);
     cl::write_summary(options.summary, summary);
   }
   return 0;
@@ -289,7 +280,6 @@ CompareRow measure(const cl::Scene& scene, CompareRow row, Advance advance) {
 }
 
 int run_compare(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (!options.summary.empty()) throw cl::InputError("--summary: a comparison writes compare.csv, not a run summary");
   if (lab.stabilize) throw cl::InputError("--stabilize: not with a comparison");
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   apply_stiffness(scene, lab.stiffness);
@@ -366,11 +356,10 @@ int run_compare(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (options.frames > 0 && (!lab.compare_pbd.empty() || !lab.compare_substeps.empty())) {
-    throw cl::InputError("--frames: only for one run (not with --compare-pbd or --compare-substeps)");
-  }
-  if (!lab.compare_pbd.empty() || !lab.compare_substeps.empty()) return run_compare(options, lab);
-  return run_one(options, lab);
+  if (lab.compare_pbd.empty() && lab.compare_substeps.empty()) return run_one(options, lab);
+  cl::refuse_run_flags(options, "only for one run (not with --compare-pbd or --compare-substeps)",
+                       "a comparison writes compare.csv, not a run summary");
+  return run_compare(options, lab);
 }
 
 }  // namespace
@@ -380,10 +369,7 @@ int main(int argc, char** argv) {
                "KKT system or by its Schur complement; writes per-frame constraint error and energy and a summary "
                "with the multipliers. Or compares PBD (lab 04) with both solves on one scene.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "ragdoll-chain-20";
-  options.method = "schur";
-  options.methods = {"kkt", "schur"};
+  cl::CommonOptions options = cl::lab_defaults("ragdoll-chain-20", "schur", {"kkt", "schur"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);

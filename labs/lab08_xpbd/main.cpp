@@ -83,8 +83,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps, substep, scene.dt,
               scene.steps);
   if (diverged) {
-    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
-                result.problem_frame * scene.dt, result.problem.c_str());
+    cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);
   } else {
     std::printf("  final:   max strain %.3e  rms %.3e  total stretch %.6e m", strain.max, strain.rms, stretch);
     if (hanging) std::printf("  (hanging at rest from its pin, springs at their k: %.6e m)", *hanging);
@@ -98,8 +97,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       std::printf("  multipliers λ/Δt² (last substep): %.6g N … %.6g N (spring 0: %.6g N; < 0 is tension)\n",
                   *low, *high, forces.front());
     }
-    std::printf("  energy:  kinetic %.4e J  potential %.4e J  elastic %.4e J  total %.6e J (start %.6e J)\n",
-                kinetic, potential, elastic, kinetic + potential + elastic, result.energy_start);
+    cl::print_energies("energy:  ", kinetic, potential, elastic, result.energy_start);
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
@@ -135,13 +133,6 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
 // ------------------------------------------------------------------ the sweep
 
-std::string status_of(const cl::lab08::RunResult& result) {
-  if (!result.problem.empty()) {
-    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
-  }
-  return result.settled ? "settled" : "not settled";
-}
-
 // Runs the scene once per K until its total stretch is steady (or for --steps
 // frames at most); one CSV row per K. The runs are independent and shared
 // among the OpenMP threads, costliest first; each row's seconds is its own.
@@ -174,10 +165,8 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
               "spread", "t_run/s", "status");
   for (std::size_t r = 0; r < ks.size(); ++r) {
     const cl::lab08::RunResult& result = results[r];
+    const std::string status = cl::settle_status(result.problem, result.problem_frame, result.settled);
     const bool measured = result.problem.empty() && result.windows_done > 0;
-    auto value = [](bool known, double number) -> cl::CsvCell {
-      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
-    };
     // k_eff / k: the stiffness the chain shows, relative to its material's
     // (the hanging stretch is proportional to 1/k).
     const bool ratio_known = measured && hanging && result.window_total_stretch > 0.0;
@@ -185,16 +174,17 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
     table.add_row({scene.name, options.method, scene.dt, static_cast<long long>(lab.substeps),
                    static_cast<long long>(ks[r]), static_cast<long long>(result.frames_done),
                    result.frames_done * scene.dt, cl::frames_in(lab.window_seconds, scene.dt) * scene.dt,
-                   value(measured, result.window_total_stretch), value(hanging.has_value(), hanging.value_or(0.0)),
-                   value(ratio_known, ratio), value(measured, result.window_max_strain),
-                   value(measured && result.window_spread >= 0.0, result.window_spread), result.max_energy_rise,
-                   result.seconds, status_of(result)});
+                   cl::cell_if(measured, result.window_total_stretch),
+                   cl::cell_if(hanging.has_value(), hanging.value_or(0.0)), cl::cell_if(ratio_known, ratio),
+                   cl::cell_if(measured, result.window_max_strain),
+                   cl::cell_if(measured && result.window_spread >= 0.0, result.window_spread), result.max_energy_rise,
+                   result.seconds, status});
     if (measured) {
       std::printf("%10d %14.6e %12.4g %10.3e %8.1e %8.2f  %s\n", ks[r], result.window_total_stretch,
                   ratio_known ? ratio : std::nan(""), result.window_max_strain, result.window_spread,
-                  result.frames_done * scene.dt, status_of(result).c_str());
+                  result.frames_done * scene.dt, status.c_str());
     } else {
-      std::printf("%10d  %s\n", ks[r], result.problem.empty() ? "too short for one window" : status_of(result).c_str());
+      std::printf("%10d  %s\n", ks[r], result.problem.empty() ? "too short for one window" : status.c_str());
     }
   }
   if (!options.out.empty()) {
@@ -205,8 +195,8 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.sweep_iterations.empty()) return run_one(options, lab);
-  if (options.frames > 0) throw cl::InputError("--frames: only for one run (not with --sweep-iterations)");
-  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
+  cl::refuse_run_flags(options, "only for one run (not with --sweep-iterations)",
+                       "a sweep writes a CSV, not a run summary");
   return run_sweep(options, lab);
 }
 
@@ -217,11 +207,7 @@ int main(int argc, char** argv) {
                "energy and a summary with the multipliers; or sweeps the iteration count and writes the steady "
                "stretch.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "hanging-chain-20";
-  options.method = "xpbd";
-  options.methods = {"pbd", "xpbd"};
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("hanging-chain-20", "xpbd", {"pbd", "xpbd"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);

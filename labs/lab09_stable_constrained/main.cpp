@@ -152,7 +152,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               describe_constraints_and_masses(scene).c_str(), options.method.c_str(), lab.geometric_stiffness.c_str(),
               lab.compression.c_str(), scene.dt, scene.steps);
   if (stopped) {
-    std::printf("  STOPPED at step %d (t = %.4g s): %s\n", problem_frame, problem_frame * scene.dt, outcome.c_str());
+    cl::print_stopped("STOPPED", "step", problem_frame, scene.dt, outcome);
   }
   if (finite) {
     std::printf("  transverse speed: %.3e m/s at the end, %.3e m/s the most over the run\n", final_transverse,
@@ -161,11 +161,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     std::printf("  energy: %.6e J (start %.6e J)\n", total_energy(particles, scene), energy_start);
   }
   std::printf("  time %.3e s: %.3e s per step\n", seconds, seconds / std::max(1, frames_done));
-  if (lambda.size() > 0 && lambda.size() <= 4) {
-    std::printf("  multipliers (N):");
-    for (Eigen::Index e = 0; e < lambda.size(); ++e) std::printf(" %.6g", lambda[e]);
-    std::printf("\n");
-  } else if (lambda.size() > 4) {
+  if (!cl::print_multipliers(lambda) && lambda.size() > 4) {
     std::printf("  multipliers from %.6g N to %.6g N (negative: tension)\n", lambda.minCoeff(), lambda.maxCoeff());
   }
 
@@ -181,12 +177,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["regularization"] = lab.regularize;
     summary.extra["steps_done"] = frames_done;
     cl::add_total_energy(summary, total_energy(particles, scene), energy_start);
-    summary.extra["diverged"] = outcome.rfind("diverged", 0) == 0;
-    summary.extra["failed"] = outcome.rfind("failed", 0) == 0;
-    if (stopped) {
-      summary.extra["outcome"] = outcome;
-      summary.extra["stopped_at_step"] = problem_frame;
-    }
+    cl::add_stop_outcome(summary, outcome, "failed", problem_frame);
     cl::write_summary(options.summary, summary);
   }
   return 0;
@@ -285,7 +276,6 @@ struct Scan {
 };
 
 int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes stability.csv, not a run summary");
   if (lab.sweep_dt_max <= lab.sweep_dt_min) {
     throw cl::InputError("--sweep-dt-max: must be larger than --sweep-dt-min");
   }
@@ -304,30 +294,22 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
   for (const double ratio : lab.sweep_mass_ratios) {
     for (const bool on : {false, true}) scans.push_back({ratio, on, {}, 0.0, 0.0});
   }
-  std::exception_ptr failure;
-  const auto scan_count = static_cast<long>(scans.size());
-#pragma omp parallel for schedule(dynamic, 1)
-  for (long k = 0; k < scan_count; ++k) {
-    Scan& scan = scans[static_cast<std::size_t>(k)];
-    try {
-      const cl::Scene chain = cl::lab09::heavy_chain(lab.sweep_links, kLinkLength, kBeadMass, scan.ratio,
-                                                     cl::kInfiniteStiffness, kKick);
-      const cl::lab09::StableSettings base = settings_for(chain, options, lab, scan.geometric_stiffness);
-      // Upwards until the first unstable step size.
-      for (const double dt : dts) {
-        scan.runs.push_back(sweep_run(chain, base, dt, steps));
-        if (!scan.runs.back().stable) {
-          scan.first_unstable = dt;
-          break;
-        }
-        scan.largest_stable = dt;
+  // The scans are independent: shared among the OpenMP threads, in order.
+  cl::run_shared(cl::costliest_first(std::vector<double>(scans.size(), 1.0)), [&](std::size_t k) {
+    Scan& scan = scans[k];
+    const cl::Scene chain = cl::lab09::heavy_chain(lab.sweep_links, kLinkLength, kBeadMass, scan.ratio,
+                                                   cl::kInfiniteStiffness, kKick);
+    const cl::lab09::StableSettings base = settings_for(chain, options, lab, scan.geometric_stiffness);
+    // Upwards until the first unstable step size.
+    for (const double dt : dts) {
+      scan.runs.push_back(sweep_run(chain, base, dt, steps));
+      if (!scan.runs.back().stable) {
+        scan.first_unstable = dt;
+        break;
       }
-    } catch (...) {
-#pragma omp critical(lab09_sweep_failure)
-      if (!failure) failure = std::current_exception();
+      scan.largest_stable = dt;
     }
-  }
-  if (failure) std::rethrow_exception(failure);
+  });
 
   cl::CsvTable limits({"mass_ratio", "geometric_stiffness", "method", "compression", "links", "steps",
                        "largest_stable_dt", "first_unstable_dt", "dt_min", "dt_max", "predicted_dt_without",
@@ -352,12 +334,11 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
       runs.add_row({scan.ratio, std::string(mode), options.method, run.dt, static_cast<long long>(run.steps_done),
                     static_cast<long long>(run.stable ? 1 : 0), run.max_transverse_speed, run.seconds, run.status});
     }
-    auto cell = [](double value) -> cl::CsvCell {
-      return value > 0.0 ? cl::CsvCell{value} : cl::CsvCell{std::string()};
-    };
     limits.add_row({scan.ratio, std::string(mode), options.method, lab.compression,
-                    static_cast<long long>(lab.sweep_links), static_cast<long long>(steps), cell(scan.largest_stable),
-                    cell(scan.first_unstable), dts.front(), dts.back(), predicted, seconds});
+                    static_cast<long long>(lab.sweep_links), static_cast<long long>(steps),
+                    cl::cell_if(scan.largest_stable > 0.0, scan.largest_stable),
+                    cl::cell_if(scan.first_unstable > 0.0, scan.first_unstable), dts.front(), dts.back(), predicted,
+                    seconds});
     char largest[32], first[32];
     std::snprintf(largest, sizeof largest, scan.largest_stable > 0.0 ? "%.4g" : "< %.4g",
                   scan.largest_stable > 0.0 ? scan.largest_stable : dts.front());
@@ -373,11 +354,10 @@ int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (options.frames > 0 && !lab.sweep_mass_ratios.empty()) {
-    throw cl::InputError("--frames: only for one run (not with --sweep-mass-ratios)");
-  }
-  if (!lab.sweep_mass_ratios.empty()) return run_sweep(options, lab);
-  return run_one(options, lab);
+  if (lab.sweep_mass_ratios.empty()) return run_one(options, lab);
+  cl::refuse_run_flags(options, "only for one run (not with --sweep-mass-ratios)",
+                       "a sweep writes stability.csv, not a run summary");
+  return run_sweep(options, lab);
 }
 
 }  // namespace
@@ -388,10 +368,7 @@ int main(int argc, char** argv) {
                "transverse speed and energy and a summary with the multipliers. Or measures the largest stable "
                "dt of a heavy chain against its mass ratio, with and without the geometric stiffness.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "heavy-chain-1000";
-  options.method = "schur";
-  options.methods = {"schur", "kkt"};
+  cl::CommonOptions options = cl::lab_defaults("heavy-chain-1000", "schur", {"schur", "kkt"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);

@@ -112,12 +112,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                 level.springs.size());
   }
   if (diverged) {
-    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame, result.problem_frame * scene.dt,
-                result.problem.c_str());
+    cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);
   } else {
     std::printf("  final:   max strain %.3e  rms %.3e\n", strain.max, strain.rms);
-    std::printf("  energy:  kinetic %.4e J  potential %.4e J  total %.6e J (start %.6e J)\n", kinetic, potential,
-                kinetic + potential, result.energy_start);
+    cl::print_energies("energy:  ", kinetic, potential, std::nullopt, result.energy_start);
   }
   std::printf("  %lld projections (%lld per step), time %.3e s: %.3e s per frame", result.projections,
               cl::lab10::projections_per_pass(hierarchy, settings.iterations), result.seconds,
@@ -259,7 +257,7 @@ int run_converge(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.converge) {
-    if (options.frames > 0) throw cl::InputError("--frames: not with --converge");
+    cl::refuse_run_flags(options, "not with --converge", "");
     return run_converge(options, lab);
   }
   if (!lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --converge");
@@ -276,8 +274,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Lab 10: hierarchical position based dynamics on a cloth. Runs a scene with a coarse-to-fine "
                "projection, or (--converge) counts the projections one step needs to reach a strain target.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "flat-curtain-64";
+  cl::CommonOptions options = cl::lab_defaults("flat-curtain-64");
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary |
                              cl::kFlagFrames);
