@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iostream>
 #include <sstream>
+#include <utility>
 
 #include "common/not_implemented.h"
 #include "common/trajectory.h"
@@ -42,6 +43,14 @@ CLI::Validator finite_in(double low, double high) {
         return message.str();
       },
       "NUMBER");
+}
+
+CommonOptions lab_defaults(std::string scene, std::string method, std::vector<std::string> methods) {
+  CommonOptions options;
+  options.scene = std::move(scene);
+  options.method = std::move(method);
+  options.methods = std::move(methods);
+  return options;
 }
 
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {

@@ -51,6 +51,10 @@ struct CommonOptions {
   bool frames_are_sweeps = false;
 };
 
+// The common options with a lab's defaults: its --scene and, for a lab that
+// takes --method, the default method and the choices (in the order --help lists them).
+CommonOptions lab_defaults(std::string scene, std::string method = {}, std::vector<std::string> methods = {});
+
 // A CLI11 check: a finite number > 0 (or >= 0 with allow_zero). Unlike CLI11's
 // own checks it rejects inf and nan and keeps the message to one short line.
 CLI::Validator finite_number(bool allow_zero);

@@ -17,6 +17,8 @@ std::string csv_field(const std::string& text) {
 }
 }  // namespace
 
+CsvCell cell_if(bool known, double value) { return known ? CsvCell{value} : CsvCell{std::string()}; }
+
 CsvTable::CsvTable(std::vector<std::string> columns) : columns_(columns.size()) {
   for (std::size_t c = 0; c < columns.size(); ++c) text_ += (c ? "," : "") + csv_field(columns[c]);
   text_ += '\n';

@@ -11,6 +11,9 @@ namespace cl {
 // says ("a, b" -> "\"a, b\"", a quote doubled), so any CSV reader splits it right.
 using CsvCell = std::variant<double, long long, std::string>;
 
+// A number where it is known, an empty cell where it is not.
+CsvCell cell_if(bool known, double value);
+
 class CsvTable {
  public:
   explicit CsvTable(std::vector<std::string> columns);

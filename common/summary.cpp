@@ -74,4 +74,13 @@ void add_divergence(RunSummary& summary, const std::string& problem, const std::
   }
 }
 
+void add_stop_outcome(RunSummary& summary, const std::string& outcome, const std::string& failure, int at) {
+  summary.extra["diverged"] = outcome.rfind("diverged", 0) == 0;
+  summary.extra[failure] = outcome.rfind(failure, 0) == 0;
+  if (!outcome.empty()) {
+    summary.extra["outcome"] = outcome;
+    summary.extra["stopped_at_step"] = at;
+  }
+}
+
 }  // namespace cl

@@ -58,4 +58,11 @@ void add_total_energy(RunSummary& summary, double total, double total_start);
 // An empty problem writes diverged = false alone and ignores at_key and at.
 void add_divergence(RunSummary& summary, const std::string& problem, const std::string& at_key, int at);
 
+// Appends the verdict of a run that stops at a step that diverged or could not
+// be taken (labs 07, 09; `outcome` is the loop's status, empty when it ran to
+// the end): diverged and `failure` (e.g. "singular"), each true when outcome
+// starts with that word, and only for a run that stopped, outcome and
+// stopped_at_step = at.
+void add_stop_outcome(RunSummary& summary, const std::string& outcome, const std::string& failure, int at);
+
 }  // namespace cl

@@ -1,50 +1,27 @@
 // lab04_pbd: position based dynamics on a scene, frame by frame: per-frame
 // strain and energy (per_frame.csv), the trajectory (./course view) and OBJ
-// meshes every --frames N frames, and the run summary. Two experiments, one invocation each:
+// meshes every --frames N frames, and the run summary. Two experiments (experiments.cpp),
+// one invocation each:
 //   --sweep-iterations 1,2,...,128          steady strain against K  -> strain_vs_iterations.csv
 //   --sweep-substeps 1,2,...,64 --cost C    substeps × K = C fixed   -> substeps.csv
-#include <algorithm>
 #include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "common/cli.h"
-#include "common/csv.h"
 #include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
+#include "experiments.h"
 #include "pbd.h"
 #include "simulation.h"
 
 namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
-
-struct LabOptions {
-  int substeps = 1;
-  double omega = 1.0;
-  double window_seconds = 1.0;     // the averaging window
-  double settle_tolerance = 0.02;  // sweeps: stop once three windows agree to this
-  double energy_seconds = 2.0;     // sweeps: the energy is compared at this time
-  std::vector<int> sweep_iterations;
-  std::vector<int> sweep_substeps;
-  int cost = 0;                    // substeps × iterations for --sweep-substeps
-  std::vector<std::string> sweep_scenes;
-};
-
-cl::lab04::PbdSettings frame_settings(const cl::Scene& scene, const cl::CommonOptions& options,
-                                      const LabOptions& lab, int iterations) {
-  cl::lab04::PbdSettings settings;
-  settings.dt = scene.dt;
-  settings.gravity = scene.gravity;
-  settings.iterations = iterations;
-  settings.projection =
-      options.method == "jacobi" ? cl::lab04::Projection::kJacobi : cl::lab04::Projection::kGaussSeidel;
-  settings.omega = lab.omega;
-  return settings;
-}
+using cl::lab04::LabOptions;
 
 // ------------------------------------------------------------------ one run
 
@@ -55,7 +32,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (options.frames > 0) cl::ensure_directory(frames_dir);
 
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
-  const cl::lab04::PbdSettings settings = frame_settings(scene, options, lab, options.iterations);
+  const cl::lab04::PbdSettings settings = cl::lab04::frame_settings(scene, options, lab, options.iterations);
   cl::lab04::RunPlan plan;
   plan.frames = scene.steps;
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
@@ -78,8 +55,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps,
               scene.dt / lab.substeps, scene.dt, scene.steps);
   if (diverged) {
-    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
-                result.problem_frame * scene.dt, result.problem.c_str());
+    cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);
   } else {
     std::printf("  final:   max strain %.3e  rms %.3e\n", strain.max, strain.rms);
     if (result.windows_done > 0) {
@@ -90,8 +66,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       }
       std::printf("\n");
     }
-    std::printf("  energy:  kinetic %.4e J  potential %.4e J  total %.6e J (start %.6e J)\n", kinetic, potential,
-                kinetic + potential, result.energy_start);
+    cl::print_energies("energy:  ", kinetic, potential, std::nullopt, result.energy_start);
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
@@ -118,100 +93,6 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   return 0;
 }
 
-// ------------------------------------------------------------------ sweeps
-
-struct SweepRun {
-  std::size_t scene = 0;
-  int substeps = 1;
-  int iterations = 0;
-  cl::lab04::RunResult result;
-};
-
-std::string status_of(const cl::lab04::RunResult& result) {
-  if (!result.problem.empty()) {
-    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
-  }
-  return result.settled ? "settled" : "not settled";
-}
-
-// Runs every scene at every (substeps, iterations) point until it settles (or
-// for --steps frames at most); one CSV row per run. The runs are independent,
-// so they are shared among the OpenMP threads, costliest first; each run's
-// wall time is its own.
-int run_sweep(const cl::CommonOptions& options, const LabOptions& lab,
-              const std::vector<std::pair<int, int>>& points, const std::string& csv_name) {
-  const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
-  std::vector<cl::lab04::ConstraintSet> constraints;
-  for (const cl::Scene& scene : scenes) {
-    constraints.push_back(cl::lab04::make_constraint_set(scene.particles.size(), scene.springs));
-  }
-
-  std::vector<SweepRun> runs;
-  std::vector<double> costs;
-  for (std::size_t s = 0; s < scenes.size(); ++s) {
-    for (const auto& [substeps, iterations] : points) {
-      runs.push_back({s, substeps, iterations, {}});
-      costs.push_back(static_cast<double>(scenes[s].springs.size() + 1) * substeps * std::max(iterations, 1));
-    }
-  }
-  cl::run_shared(cl::costliest_first(costs), [&](std::size_t r) {
-    SweepRun& run = runs[r];
-    const cl::Scene& scene = scenes[run.scene];
-    cl::Particles particles = scene.particles;
-    cl::lab04::RunPlan plan;
-    plan.frames = scene.steps;
-    plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
-    plan.settle_tolerance = lab.settle_tolerance;
-    plan.energy_frame = cl::frames_in(lab.energy_seconds, scene.dt);
-    run.result = cl::lab04::run_frames(particles, constraints[run.scene],
-                                       frame_settings(scene, options, lab, run.iterations), run.substeps, plan);
-  });
-
-  cl::CsvTable table({"scene", "nx", "ny", "particles", "springs", "method", "dt", "substeps", "iterations",
-                      "frames_run", "time_run", "window_seconds", "steady_max_strain", "steady_rms_strain",
-                      "window_spread", "energy_start", "energy_seconds", "energy_at_seconds", "energy_end",
-                      "max_energy_rise", "seconds", "status"});
-  std::printf("%s: %s; each run until the mean max strain of three %.3g s windows agrees to %.3g (at most %s "
-              "frames)\n",
-              kLab, options.method.c_str(), lab.window_seconds, lab.settle_tolerance,
-              options.steps >= 0 ? std::to_string(options.steps).c_str() : "the scene's");
-  std::printf("%-12s %8s %10s %12s %12s %8s %8s %13s %9s  %s\n", "scene", "substeps", "iterations", "steady_max",
-              "steady_rms", "spread", "t_run/s", "E(te)-E(0)/J", "seconds", "status");
-  for (const SweepRun& run : runs) {
-    const cl::Scene& scene = scenes[run.scene];
-    const cl::lab04::RunResult& result = run.result;
-    const bool ok = result.problem.empty();
-    const bool measured = ok && result.windows_done > 0;
-    const bool energy_known = ok && result.frames_done >= cl::frames_in(lab.energy_seconds, scene.dt);
-    auto value = [](bool known, double number) -> cl::CsvCell {
-      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
-    };
-    const double window_seconds = cl::frames_in(lab.window_seconds, scene.dt) * scene.dt;
-    const double energy_seconds = cl::frames_in(lab.energy_seconds, scene.dt) * scene.dt;
-    table.add_row({scene.name, static_cast<long long>(scene.grid_nx), static_cast<long long>(scene.grid_ny),
-                   static_cast<long long>(scene.particles.size()), static_cast<long long>(scene.springs.size()),
-                   options.method, scene.dt, static_cast<long long>(run.substeps),
-                   static_cast<long long>(run.iterations), static_cast<long long>(result.frames_done),
-                   result.frames_done * scene.dt, window_seconds, value(measured, result.window_max_strain),
-                   value(measured, result.window_rms_strain),
-                   value(measured && result.window_spread >= 0.0, result.window_spread), result.energy_start,
-                   energy_seconds, value(energy_known, result.energy_at_mark), value(ok, result.energy_end),
-                   result.max_energy_rise, result.seconds, status_of(result)});
-    if (measured) {
-      std::printf("%-12s %8d %10d %12.4e %12.4e %8.1e %8.2f %13.4e %9.3f  %s\n", scene.name.c_str(), run.substeps,
-                  run.iterations, result.window_max_strain, result.window_rms_strain, result.window_spread,
-                  result.frames_done * scene.dt, energy_known ? result.energy_at_mark - result.energy_start : 0.0,
-                  result.seconds, status_of(result).c_str());
-    } else {
-      std::printf("%-12s %8d %10d  %s\n", scene.name.c_str(), run.substeps, run.iterations,
-                  ok ? "too short for one window" : status_of(result).c_str());
-    }
-  }
-  if (!options.out.empty()) table.write(cl::join_path(options.out, csv_name));
-  return 0;
-}
-
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (options.frames > 0 && options.out.empty()) {
     throw cl::InputError("--frames: needs --out DIR for the trajectory and the OBJ files");
@@ -223,12 +104,12 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
     }
     return run_one(options, lab);
   }
-  if (options.frames > 0) throw cl::InputError("--frames: not with a sweep (run one configuration instead)");
-  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
+  cl::refuse_run_flags(options, "not with a sweep (run one configuration instead)",
+                       "a sweep writes a CSV, not a run summary");
   std::vector<std::pair<int, int>> points;  // (substeps, iterations)
   if (!lab.sweep_iterations.empty()) {
     for (const int k : lab.sweep_iterations) points.emplace_back(lab.substeps, k);
-    return run_sweep(options, lab, points, "strain_vs_iterations.csv");
+    return cl::lab04::run_sweep(kLab, CL_LAB_SCENE_DIR, options, lab, points, "strain_vs_iterations.csv");
   }
   if (lab.cost < 1) throw cl::InputError("--sweep-substeps: needs --cost C (substeps × iterations)");
   for (const int n : lab.sweep_substeps) {
@@ -238,7 +119,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
     }
     points.emplace_back(n, lab.cost / n);
   }
-  return run_sweep(options, lab, points, "substeps.csv");
+  return cl::lab04::run_sweep(kLab, CL_LAB_SCENE_DIR, options, lab, points, "substeps.csv");
 }
 
 }  // namespace
@@ -247,11 +128,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
                "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "curtain-16";
-  options.method = "gauss-seidel";
-  options.methods = {"gauss-seidel", "jacobi"};
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("curtain-16", "gauss-seidel", {"gauss-seidel", "jacobi"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);

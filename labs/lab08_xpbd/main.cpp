@@ -1,21 +1,19 @@
 // lab08_xpbd: PBD or XPBD on a scene, frame by frame: per-frame strain,
 // stretch and energy (per_frame.csv) and the run summary with each spring's
-// multiplier. The experiment, one invocation per method:
+// multiplier. The experiment (experiments.cpp), one invocation per method:
 //   --sweep-iterations 1,2,...,1024   steady stretch against K -> stretch_vs_iterations_<method>.csv
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <exception>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "common/cli.h"
-#include "common/csv.h"
 #include "common/driver.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
+#include "experiments.h"
 #include "pbd.h"
 #include "simulation.h"
 #include "xpbd.h"
@@ -23,24 +21,7 @@
 namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
-
-struct LabOptions {
-  int substeps = 1;
-  double window_seconds = 1.0;      // the averaging window
-  double settle_tolerance = 1e-3;   // sweeps: stop once three windows agree to this
-  std::vector<int> sweep_iterations;
-};
-
-cl::lab08::FrameSettings frame_settings(const cl::Scene& scene, const cl::CommonOptions& options,
-                                        const LabOptions& lab, int iterations) {
-  cl::lab08::FrameSettings settings;
-  settings.method = options.method == "pbd" ? cl::lab08::Method::kPbd : cl::lab08::Method::kXpbd;
-  settings.dt = scene.dt;
-  settings.gravity = scene.gravity;
-  settings.iterations = iterations;
-  settings.substeps = lab.substeps;
-  return settings;
-}
+using cl::lab08::LabOptions;
 
 // The multipliers in newtons: λ / Δt² with Δt the substep (λ is force × Δt²).
 std::vector<double> multipliers_in_newtons(const Eigen::VectorXd& lambda, double substep) {
@@ -56,7 +37,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) cl::ensure_directory(options.out);
 
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
-  const cl::lab08::FrameSettings settings = frame_settings(scene, options, lab, options.iterations);
+  const cl::lab08::FrameSettings settings = cl::lab08::frame_settings(scene, options, lab, options.iterations);
   const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
   cl::lab08::RunPlan plan;
   plan.frames = scene.steps;
@@ -83,8 +64,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
               cl::describe(scene).c_str(), options.method.c_str(), options.iterations, lab.substeps, substep, scene.dt,
               scene.steps);
   if (diverged) {
-    std::printf("  DIVERGED at frame %d (t = %.4g s): %s\n", result.problem_frame,
-                result.problem_frame * scene.dt, result.problem.c_str());
+    cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);
   } else {
     std::printf("  final:   max strain %.3e  rms %.3e  total stretch %.6e m", strain.max, strain.rms, stretch);
     if (hanging) std::printf("  (hanging at rest from its pin, springs at their k: %.6e m)", *hanging);
@@ -98,8 +78,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       std::printf("  multipliers λ/Δt² (last substep): %.6g N … %.6g N (spring 0: %.6g N; < 0 is tension)\n",
                   *low, *high, forces.front());
     }
-    std::printf("  energy:  kinetic %.4e J  potential %.4e J  elastic %.4e J  total %.6e J (start %.6e J)\n",
-                kinetic, potential, elastic, kinetic + potential + elastic, result.energy_start);
+    cl::print_energies("energy:  ", kinetic, potential, elastic, result.energy_start);
   }
   const double projections = static_cast<double>(result.frames_done) * lab.substeps * options.iterations *
                              static_cast<double>(scene.springs.size());
@@ -133,81 +112,11 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   return 0;
 }
 
-// ------------------------------------------------------------------ the sweep
-
-std::string status_of(const cl::lab08::RunResult& result) {
-  if (!result.problem.empty()) {
-    return "diverged at frame " + std::to_string(result.problem_frame) + ": " + result.problem;
-  }
-  return result.settled ? "settled" : "not settled";
-}
-
-// Runs the scene once per K until its total stretch is steady (or for --steps
-// frames at most); one CSV row per K. The runs are independent and shared
-// among the OpenMP threads, costliest first; each row's seconds is its own.
-int run_sweep(const cl::CommonOptions& options, const LabOptions& lab) {
-  const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
-  const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
-  const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
-
-  const std::vector<int>& ks = lab.sweep_iterations;
-  std::vector<cl::lab08::RunResult> results(ks.size());
-  cl::run_shared(cl::costliest_first(std::vector<double>(ks.begin(), ks.end())), [&](std::size_t r) {
-    cl::Particles particles = scene.particles;
-    cl::lab08::RunPlan plan;
-    plan.frames = scene.steps;
-    plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
-    plan.settle_tolerance = lab.settle_tolerance;
-    results[r] = cl::lab08::run_frames(particles, constraints, frame_settings(scene, options, lab, ks[r]), plan);
-  });
-
-  cl::CsvTable table({"scene", "method", "dt", "substeps", "iterations", "frames_run", "time_run", "window_seconds",
-                      "steady_total_stretch", "material_total_stretch", "stiffness_ratio", "steady_max_strain",
-                      "window_spread", "max_energy_rise", "seconds", "status"});
-  std::printf("%s: %s on %s; each run until the mean total stretch of three %.3g s windows agrees to %.3g "
-              "(at most %d frames)\n",
-              kLab, options.method.c_str(), cl::describe(scene).c_str(), lab.window_seconds, lab.settle_tolerance,
-              scene.steps);
-  if (hanging) std::printf("  hanging at rest with its springs' stiffness: total stretch %.6e m\n", *hanging);
-  std::printf("%10s %14s %12s %10s %8s %8s  %s\n", "iterations", "steady_stretch", "k_eff/k", "max_strain",
-              "spread", "t_run/s", "status");
-  for (std::size_t r = 0; r < ks.size(); ++r) {
-    const cl::lab08::RunResult& result = results[r];
-    const bool measured = result.problem.empty() && result.windows_done > 0;
-    auto value = [](bool known, double number) -> cl::CsvCell {
-      return known ? cl::CsvCell{number} : cl::CsvCell{std::string()};
-    };
-    // k_eff / k: the stiffness the chain shows, relative to its material's
-    // (the hanging stretch is proportional to 1/k).
-    const bool ratio_known = measured && hanging && result.window_total_stretch > 0.0;
-    const double ratio = ratio_known ? *hanging / result.window_total_stretch : 0.0;
-    table.add_row({scene.name, options.method, scene.dt, static_cast<long long>(lab.substeps),
-                   static_cast<long long>(ks[r]), static_cast<long long>(result.frames_done),
-                   result.frames_done * scene.dt, cl::frames_in(lab.window_seconds, scene.dt) * scene.dt,
-                   value(measured, result.window_total_stretch), value(hanging.has_value(), hanging.value_or(0.0)),
-                   value(ratio_known, ratio), value(measured, result.window_max_strain),
-                   value(measured && result.window_spread >= 0.0, result.window_spread), result.max_energy_rise,
-                   result.seconds, status_of(result)});
-    if (measured) {
-      std::printf("%10d %14.6e %12.4g %10.3e %8.1e %8.2f  %s\n", ks[r], result.window_total_stretch,
-                  ratio_known ? ratio : std::nan(""), result.window_max_strain, result.window_spread,
-                  result.frames_done * scene.dt, status_of(result).c_str());
-    } else {
-      std::printf("%10d  %s\n", ks[r], result.problem.empty() ? "too short for one window" : status_of(result).c_str());
-    }
-  }
-  if (!options.out.empty()) {
-    table.write(cl::join_path(options.out, "stretch_vs_iterations_" + options.method + ".csv"));
-  }
-  return 0;
-}
-
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.sweep_iterations.empty()) return run_one(options, lab);
-  if (options.frames > 0) throw cl::InputError("--frames: only for one run (not with --sweep-iterations)");
-  if (!options.summary.empty()) throw cl::InputError("--summary: a sweep writes a CSV, not a run summary");
-  return run_sweep(options, lab);
+  cl::refuse_run_flags(options, "only for one run (not with --sweep-iterations)",
+                       "a sweep writes a CSV, not a run summary");
+  return cl::lab08::run_sweep(kLab, CL_LAB_SCENE_DIR, options, lab);
 }
 
 }  // namespace
@@ -217,11 +126,7 @@ int main(int argc, char** argv) {
                "energy and a summary with the multipliers; or sweeps the iteration count and writes the steady "
                "stretch.",
                CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "hanging-chain-20";
-  options.method = "xpbd";
-  options.methods = {"pbd", "xpbd"};
-  options.iterations = 10;
+  cl::CommonOptions options = cl::lab_defaults("hanging-chain-20", "xpbd", {"pbd", "xpbd"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);

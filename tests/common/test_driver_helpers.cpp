@@ -188,3 +188,26 @@ TEST_CASE("an OBJ frame is named by its zero-padded number and says what it is",
   CHECK(lines == 1);  // no triangles: the spring as a line
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("add_stop_outcome writes diverged and the failure, and only for a stopped run its outcome and step",
+          "[common]") {
+  cl::RunSummary fine;
+  cl::add_stop_outcome(fine, "", "singular", 17);
+  CHECK(keys_of(fine.extra) == std::vector<std::string>{"diverged", "singular"});
+  CHECK(fine.extra["diverged"] == false);
+  CHECK(fine.extra["singular"] == false);
+
+  cl::RunSummary diverged;
+  cl::add_stop_outcome(diverged, "diverged: positions are not finite", "failed", 3);
+  CHECK(keys_of(diverged.extra) == std::vector<std::string>{"diverged", "failed", "outcome", "stopped_at_step"});
+  CHECK(diverged.extra["diverged"] == true);
+  CHECK(diverged.extra["failed"] == false);
+  CHECK(diverged.extra["outcome"] == "diverged: positions are not finite");
+  CHECK(diverged.extra["stopped_at_step"] == 3);
+
+  cl::RunSummary singular;
+  cl::add_stop_outcome(singular, "singular: J W J^T", "singular", 1);
+  CHECK(singular.extra["diverged"] == false);
+  CHECK(singular.extra["singular"] == true);
+  CHECK(singular.extra["stopped_at_step"] == 1);
+}

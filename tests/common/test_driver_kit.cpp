@@ -1,5 +1,7 @@
 // common/driver.h: the scenes of a sweep, its runs costliest first and shared
-// among threads (every run done, the first failure thrown again).
+// among threads (every run done, the first failure thrown again), an
+// experiment's refusals and the settle status; common/cli.h's lab_defaults;
+// common/csv.h's cell_if.
 #include <atomic>
 #include <fstream>
 #include <stdexcept>
@@ -8,6 +10,7 @@
 
 #include <catch2/catch.hpp>
 
+#include "common/csv.h"
 #include "common/driver.h"
 #include "common/output.h"
 
@@ -61,4 +64,39 @@ TEST_CASE("run_shared runs every index once and throws the first failure after a
                                    }),
                     "run 7 failed");
   CHECK(done == 50);
+}
+
+TEST_CASE("lab_defaults sets the scene, the method and its choices, and leaves the rest", "[common][driver]") {
+  const cl::CommonOptions plain = cl::lab_defaults("curtain-16");
+  CHECK(plain.scene == "curtain-16");
+  CHECK(plain.method.empty());
+  CHECK(plain.methods.empty());
+  CHECK(plain.iterations == cl::CommonOptions{}.iterations);
+  const cl::CommonOptions with = cl::lab_defaults("chain", "schur", {"kkt", "schur"});
+  CHECK(with.method == "schur");
+  CHECK(with.methods == std::vector<std::string>{"kkt", "schur"});
+}
+
+TEST_CASE("refuse_run_flags refuses --frames, then --summary, each with its reason; an empty reason lets it by",
+          "[common][driver]") {
+  cl::CommonOptions options;
+  CHECK_NOTHROW(cl::refuse_run_flags(options, "not with a sweep", "a sweep writes a CSV"));
+  options.frames = 2;
+  options.summary = "s.json";
+  CHECK_THROWS_MATCHES(cl::refuse_run_flags(options, "not with a sweep", "a sweep writes a CSV"), cl::InputError,
+                       Catch::Message("--frames: not with a sweep"));
+  CHECK_THROWS_MATCHES(cl::refuse_run_flags(options, "", "a sweep writes a CSV"), cl::InputError,
+                       Catch::Message("--summary: a sweep writes a CSV"));
+  CHECK_NOTHROW(cl::refuse_run_flags(options, "", ""));
+}
+
+TEST_CASE("settle_status: settled, not settled, or where and why the run diverged", "[common][driver]") {
+  CHECK(cl::settle_status("", 12, true) == "settled");
+  CHECK(cl::settle_status("", 12, false) == "not settled");
+  CHECK(cl::settle_status("strain 12", 7, true) == "diverged at frame 7: strain 12");
+}
+
+TEST_CASE("cell_if is the number where it is known and an empty cell where it is not", "[common][driver]") {
+  CHECK(cl::cell_if(true, 0.5) == cl::CsvCell{0.5});
+  CHECK(cl::cell_if(false, 0.5) == cl::CsvCell{std::string()});
 }
