@@ -1,5 +1,6 @@
 #include "common/driver.h"
 
+#include <cmath>
 #include <cstdio>
 #include <utility>
 
@@ -34,6 +35,15 @@ std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<s
 void refuse_run_flags(const CommonOptions& options, const std::string& frames_why, const std::string& summary_why) {
   if (options.frames > 0 && !frames_why.empty()) throw InputError("--frames: " + frames_why);
   if (!options.summary.empty() && !summary_why.empty()) throw InputError("--summary: " + summary_why);
+}
+
+void require_finite_springs(const Scene& scene, const std::string& why) {
+  for (std::size_t e = 0; e < scene.springs.size(); ++e) {
+    if (!std::isfinite(scene.springs[e].stiffness)) {
+      throw InputError(scene.source + ": springs[" + std::to_string(e) + "].stiffness: inf is a hard constraint; " +
+                       why);
+    }
+  }
 }
 
 std::string settle_status(const std::string& problem, int frame, bool settled) {

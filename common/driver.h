@@ -37,6 +37,11 @@ FrameOutput frame_output(const CommonOptions& options, const char* lab, const Sc
 // --summary with "--summary: " + summary_why. An empty reason lets that flag by.
 void refuse_run_flags(const CommonOptions& options, const std::string& frames_why, const std::string& summary_why);
 
+// A lab that minimises the springs' energy (labs 11, 12) takes no hard spring:
+// the first spring of stiffness inf is refused with InputError
+// "<source>: springs[e].stiffness: inf is a hard constraint; <why>".
+void require_finite_springs(const Scene& scene, const std::string& why);
+
 // The CSV status of a run that settles (labs 04, 08): "settled", "not
 // settled", or for a run that stopped at a problem "diverged at frame F: problem".
 std::string settle_status(const std::string& problem, int frame, bool settled);

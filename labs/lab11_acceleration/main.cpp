@@ -36,11 +36,9 @@ cl::Scene load(const cl::CommonOptions& options, const std::string& name, Method
   cl::CommonOptions one = options;
   one.scene = name;
   cl::Scene scene = cl::load_scene_for(one, CL_LAB_SCENE_DIR);
-  for (std::size_t e = 0; cl::lab11::minimises_objective(method) && e < scene.springs.size(); ++e) {
-    if (!std::isfinite(scene.springs[e].stiffness)) {
-      throw cl::InputError(scene.source + ": springs[" + std::to_string(e) + "].stiffness: inf is a hard constraint; " +
-                           cl::lab11::method_name(method) + " needs finite springs (or a PBD method)");
-    }
+  if (cl::lab11::minimises_objective(method)) {
+    cl::require_finite_springs(scene,
+                               std::string(cl::lab11::method_name(method)) + " needs finite springs (or a PBD method)");
   }
   return scene;
 }
@@ -166,10 +164,9 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
 int main(int argc, char** argv) {
   CLI::App app{"Lab 11: projective dynamics accelerated by Chebyshev and by L-BFGS on PD's matrix, and Jacobi PBD "
                "by Chebyshev. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "pd-curtain-16";
-  options.method = "pd-chebyshev";
-  options.methods = {"pd", "pd-chebyshev", "pd-lbfgs", "newton", "jacobi", "jacobi-chebyshev", "gauss-seidel"};
+  cl::CommonOptions options = cl::lab_defaults(
+      "pd-curtain-16", "pd-chebyshev",
+      {"pd", "pd-chebyshev", "pd-lbfgs", "newton", "jacobi", "jacobi-chebyshev", "gauss-seidel"});
   options.iterations = 10;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
@@ -197,9 +194,7 @@ int main(int argc, char** argv) {
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
-    if (lab.convergence && options.frames > 0) {
-      throw cl::InputError("--frames: only for a run of steps (not with --convergence)");
-    }
+    if (lab.convergence) cl::refuse_run_flags(options, "only for a run of steps (not with --convergence)", "");
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
 }

@@ -35,15 +35,6 @@ struct LabOptions {
   std::vector<std::string> sweep_scenes;
 };
 
-void require_finite_springs(const cl::Scene& scene) {
-  for (std::size_t e = 0; e < scene.springs.size(); ++e) {
-    if (!std::isfinite(scene.springs[e].stiffness)) {
-      throw cl::InputError(scene.source + ": springs[" + std::to_string(e) +
-                           "].stiffness: inf is a hard constraint; VBD minimises finite springs' energy");
-    }
-  }
-}
-
 // --rho, or ρ of plain VBD measured on the scene's first step; 0 for plain VBD.
 double rho_for(const cl::lab12::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
   if (method != Method::kVbdChebyshev) return 0.0;
@@ -59,7 +50,7 @@ double rho_for(const cl::lab12::Solver& solver, const cl::Scene& scene, Method m
 int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab12::method_from_name(options.method);
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  require_finite_springs(scene);
+  cl::require_finite_springs(scene, "VBD minimises finite springs' energy");
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::lab12::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   cl::lab12::Settings& settings = lab.settings;
@@ -109,7 +100,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   if (!options.summary.empty()) throw cl::InputError("--summary: --convergence writes CSV files, not a run summary");
   const Method method = cl::lab12::method_from_name(options.method);
   const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, CL_LAB_SCENE_DIR);
-  for (const cl::Scene& scene : scenes) require_finite_springs(scene);
+  for (const cl::Scene& scene : scenes) cl::require_finite_springs(scene, "VBD minimises finite springs' energy");
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::CsvTable table({"scene", "method", "init", "rho", "colours", "threads", "iteration", "objective",
                       "objective_error", "omega", "restarted", "seconds"});
@@ -166,10 +157,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
 int main(int argc, char** argv) {
   CLI::App app{"Lab 12: the implicit-Euler step by vertex block descent (Chen et al. 2024), plain or with Chebyshev "
                "acceleration. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
-  cl::CommonOptions options;
-  options.scene = "pd-curtain-16";
-  options.method = "vbd";
-  options.methods = {"vbd", "vbd-chebyshev"};
+  cl::CommonOptions options = cl::lab_defaults("pd-curtain-16", "vbd", {"vbd", "vbd-chebyshev"});
   options.iterations = 10;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
@@ -191,7 +179,7 @@ int main(int argc, char** argv) {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
-    if (lab.convergence && options.frames > 0) throw cl::InputError("--frames: only for a run of steps");
+    if (lab.convergence) cl::refuse_run_flags(options, "only for a run of steps", "");
     lab.settings.init = cl::lab12::init_from_name(lab.init);
     omp_set_num_threads(lab.threads);
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
