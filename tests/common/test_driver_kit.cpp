@@ -1,6 +1,6 @@
 // common/driver.h: the scenes of a sweep, its runs costliest first and shared
 // among threads (every run done, the first failure thrown again), an
-// experiment's refusals and the settle status; common/cli.h's lab_defaults;
+// experiment's refusals, a hard spring's refusal and the settle status; common/cli.h's lab_defaults;
 // common/csv.h's cell_if.
 #include <atomic>
 #include <fstream>
@@ -99,4 +99,14 @@ TEST_CASE("settle_status: settled, not settled, or where and why the run diverge
 TEST_CASE("cell_if is the number where it is known and an empty cell where it is not", "[common][driver]") {
   CHECK(cl::cell_if(true, 0.5) == cl::CsvCell{0.5});
   CHECK(cl::cell_if(false, 0.5) == cl::CsvCell{std::string()});
+}
+
+TEST_CASE("require_finite_springs names the first hard spring and lets finite ones by", "[common][driver]") {
+  cl::CommonOptions options;
+  options.scene = scene_file("hard", 1);  // its spring has the default stiffness, inf
+  cl::Scene scene = cl::load_scenes(options, {}, ".").front();
+  CHECK_THROWS_WITH(cl::require_finite_springs(scene, "why"),
+                    scene.source + ": springs[0].stiffness: inf is a hard constraint; why");
+  scene.springs[0].stiffness = 1e12;
+  CHECK_NOTHROW(cl::require_finite_springs(scene, "why"));
 }
