@@ -6,11 +6,22 @@
 #include <stdexcept>
 #include <string>
 
+#include <dlfcn.h>
+
 #ifdef CL_HAVE_CHOLMOD
 #include <cholmod.h>
 #endif
 
 namespace cl {
+
+bool set_blas_threads(int threads) {
+  if (threads < 1) throw std::invalid_argument("set_blas_threads: threads " + std::to_string(threads) + " < 1");
+  void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
+  if (symbol == nullptr) return false;
+  using SetThreads = void (*)(int);
+  reinterpret_cast<SetThreads>(symbol)(threads);
+  return true;
+}
 
 MovableMap make_movable_map(const Eigen::VectorXd& inv_mass) {
   MovableMap map;

@@ -60,6 +60,13 @@ enum class SpdBackend { kSimplicial, kSupernodal, kAutomatic };
 const char* backend_name(SpdBackend backend);  // "simplicial-ldlt", "supernodal-llt", "automatic"
 // True when the suite was built with CHOLMOD (Debian's libsuitesparse-dev).
 bool cholmod_available();
+// Sets the threads of the BLAS behind the supernodal factorization where the
+// BLAS offers it (OpenBLAS's openblas_set_num_threads, looked up at run time,
+// so any BLAS links); returns whether it could. OpenBLAS otherwise takes every
+// core, and its waiting threads spin: a benchmark that times serial methods
+// side by side sets 1, or a second job on the machine slows it many-fold.
+bool set_blas_threads(int threads);
+
 // The flop count (Σ_j c_j², c_j the entries of L below the diagonal in column
 // j, in CHOLMOD's ordering) from which kAutomatic takes the supernodal
 // factorization. Measured with bench/bench_lab06 (BM_FactorBackends, CPU

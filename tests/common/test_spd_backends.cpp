@@ -156,3 +156,18 @@ TEST_CASE("the automatic choice is supernodal exactly when CHOLMOD is there and 
   CHECK_THAT(max_abs(large_automatic.eigen().solve(many) - many_expected),
              WithinAbs(0.0, 1e-9 * max_abs(many_expected)));
 }
+
+TEST_CASE("one BLAS thread gives the supernodal factorization's solves and a count below 1 is refused",
+          "[sparse][backend]") {
+  CHECK_THROWS_AS(cl::set_blas_threads(0), std::invalid_argument);
+  // With CHOLMOD the course's BLAS is OpenBLAS (./course installs it), which lets its threads be set.
+  if (cl::cholmod_available()) CHECK(cl::set_blas_threads(1));
+  std::mt19937_64 rng(7);
+  const cl::SparseMatrix matrix = grid_hessian(rng, 24);
+  cl::SpdFactorization supernodal(cl::SpdBackend::kSupernodal), reference(cl::SpdBackend::kSimplicial);
+  REQUIRE(supernodal.factor(matrix));
+  REQUIRE(reference.factor(matrix));
+  const cl::RowsX3 b = cl::RowsX3::Random(matrix.rows(), 3);
+  const Eigen::MatrixXd expected = reference.solve3(b);
+  CHECK_THAT(max_abs(Eigen::MatrixXd(supernodal.solve3(b)) - expected), WithinAbs(0.0, 1e-9 * max_abs(expected)));
+}
