@@ -77,7 +77,7 @@ TEST_CASE("lab_defaults sets the scene, the method and its choices, and leaves t
   CHECK(with.methods == std::vector<std::string>{"kkt", "schur"});
 }
 
-TEST_CASE("refuse_run_flags refuses --frames, then --summary, each with its reason; an empty reason lets it by",
+TEST_CASE("refuse_run_flags refuses --frames, then --summary, each with its reason, and an empty reason lets it by",
           "[common][driver]") {
   cl::CommonOptions options;
   CHECK_NOTHROW(cl::refuse_run_flags(options, "not with a sweep", "a sweep writes a CSV"));
