@@ -105,7 +105,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
 }
 
 int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
-  if (!options.summary.empty()) throw cl::InputError("--summary: --convergence writes CSV files, not a run summary");
+  cl::refuse_run_flags(options, "", "--convergence writes CSV files, not a run summary");
   const Method method = cl::lab11::method_from_name(options.method);
   const bool pd = cl::lab11::minimises_objective(method);
   if (!options.out.empty()) cl::ensure_directory(options.out);

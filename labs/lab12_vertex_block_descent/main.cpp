@@ -97,7 +97,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
 }
 
 int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
-  if (!options.summary.empty()) throw cl::InputError("--summary: --convergence writes CSV files, not a run summary");
+  cl::refuse_run_flags(options, "", "--convergence writes CSV files, not a run summary");
   const Method method = cl::lab12::method_from_name(options.method);
   const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, CL_LAB_SCENE_DIR);
   for (const cl::Scene& scene : scenes) cl::require_finite_springs(scene, "VBD minimises finite springs' energy");
