@@ -93,6 +93,49 @@ const char* backend_name(SpdBackend backend) {
 #ifdef CL_HAVE_CHOLMOD
 bool cholmod_available() { return true; }
 
+namespace {
+
+// CHOLMOD 5 (Debian 12's SuiteSparse 5.12) opens OpenMP regions of a fixed
+// num_threads(4) inside its supernodal factorization (CHOLMOD_OMP_NUM_THREADS
+// in cholmod_core.h), whatever the machine has and omp_set_num_threads says.
+// Those regions only clear and copy (the arithmetic is in the BLAS, see
+// set_blas_threads), yet on 2 cores their four threads, woken and put to sleep
+// once per supernode, doubled Newton's iteration at 128² (bench/trade, one
+// thread: 375 ms per iteration with them, 186 ms without). While CHOLMOD runs,
+// this guard sets max-active-levels to 0, so every region it opens runs on the
+// calling thread alone. libgomp keeps that setting process-wide, so the guard
+// acts only outside active parallel regions (omp_get_active_level() == 0: no
+// other OpenMP thread is running), and puts the old value back. Inside an
+// active region CHOLMOD's regions are nested and already serial unless nesting
+// was switched on. The functions are looked up at run time, like the BLAS's
+// setter: common is compiled without OpenMP, and without an OpenMP runtime in
+// the process the guard does nothing.
+class SerialOpenMpRegions {
+ public:
+  SerialOpenMpRegions() {
+    using Get = int (*)();
+    static const auto active_level = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "omp_get_active_level"));
+    static const auto get_levels = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+    static const auto set_levels = reinterpret_cast<Set>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+    if (active_level == nullptr || get_levels == nullptr || set_levels == nullptr || active_level() != 0) return;
+    set_ = set_levels;
+    saved_ = get_levels();
+    set_(0);
+  }
+  ~SerialOpenMpRegions() {
+    if (set_ != nullptr) set_(saved_);
+  }
+  SerialOpenMpRegions(const SerialOpenMpRegions&) = delete;
+  SerialOpenMpRegions& operator=(const SerialOpenMpRegions&) = delete;
+
+ private:
+  using Set = void (*)(int);
+  Set set_ = nullptr;
+  int saved_ = 0;
+};
+
+}  // namespace
+
 // One CHOLMOD workspace and factor per SpdFactorization that uses it.
 struct SpdFactorization::Cholmod {
   cholmod_common common;
@@ -141,6 +184,7 @@ void cholmod_solve_columns(cholmod_factor* factor, cholmod_common& common, doubl
   b.x = data;
   b.xtype = CHOLMOD_REAL;
   b.dtype = CHOLMOD_DOUBLE;
+  const SerialOpenMpRegions serial;
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor, &b, &common);
   if (x == nullptr) throw std::runtime_error("SpdFactorization: CHOLMOD's solve failed (out of memory?)");
   std::copy(static_cast<const double*>(x->x), static_cast<const double*>(x->x) + rows * columns, data);
@@ -204,6 +248,7 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
     if (!cholmod_) cholmod_ = std::make_unique<Cholmod>();
     if (cholmod_->factor != nullptr) cholmod_free_factor(&cholmod_->factor, &cholmod_->common);
     cholmod_sparse view = view_of(*matrix);
+    const SerialOpenMpRegions serial;
     cholmod_->factor = cholmod_analyze(&view, &cholmod_->common);
     if (cholmod_->factor == nullptr) return false;
     const int* counts = static_cast<const int*>(cholmod_->factor->ColCount);
@@ -254,6 +299,7 @@ bool SpdFactorization::numeric(const SparseMatrix& a) {
   ++supernodal_count;
   cholmod_sparse view = view_of(a);
   cholmod_factor* factor = cholmod_->factor;
+  const SerialOpenMpRegions serial;
   // Not positive definite: CHOLMOD stops at column `minor` < n.
   if (!cholmod_factorize(&view, factor, &cholmod_->common) || cholmod_->common.status != CHOLMOD_OK ||
       factor->minor < factor->n) {

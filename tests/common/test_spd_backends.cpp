@@ -4,10 +4,14 @@
 // chooses by the flop count it documents. Without CHOLMOD in the build the
 // supernodal requests fall back to Eigen, and the same checks hold.
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <random>
 #include <stdexcept>
+#include <string>
 #include <vector>
+
+#include <dlfcn.h>
 
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
@@ -170,4 +174,45 @@ TEST_CASE("one BLAS thread gives the supernodal factorization's solves and a cou
   const cl::RowsX3 b = cl::RowsX3::Random(matrix.rows(), 3);
   const Eigen::MatrixXd expected = reference.solve3(b);
   CHECK_THAT(max_abs(Eigen::MatrixXd(supernodal.solve3(b)) - expected), WithinAbs(0.0, 1e-9 * max_abs(expected)));
+}
+
+namespace {
+
+// The threads of this process now (Linux: /proc/self/status).
+int process_threads() {
+  std::ifstream status("/proc/self/status");
+  std::string line;
+  while (std::getline(status, line)) {
+    if (line.rfind("Threads:", 0) == 0) return std::stoi(line.substr(8));
+  }
+  return -1;
+}
+
+}  // namespace
+
+TEST_CASE("the supernodal factorization starts no OpenMP threads and leaves max-active-levels as it was",
+          "[sparse][backend]") {
+  // CHOLMOD 5 asks for four OpenMP threads in its own loops; common/sparse.cpp
+  // runs them on the calling thread (SerialOpenMpRegions). OpenMP keeps the
+  // threads of a region for the next one, so a region with four would leave
+  // three more threads in the process. OpenBLAS starts its threads when loaded.
+  if (!cl::cholmod_available()) return;
+  using Get = int (*)();
+  using Set = void (*)(int);
+  const auto get_levels = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "omp_get_max_active_levels"));
+  const auto set_levels = reinterpret_cast<Set>(dlsym(RTLD_DEFAULT, "omp_set_max_active_levels"));
+  REQUIRE(get_levels != nullptr);  // CHOLMOD links libgomp
+  REQUIRE(set_levels != nullptr);
+  set_levels(3);
+  std::mt19937_64 rng(11);
+  const cl::SparseMatrix matrix = grid_hessian(rng, 24);
+  const int before = process_threads();
+  REQUIRE(before > 0);
+  cl::SpdFactorization supernodal(cl::SpdBackend::kSupernodal);
+  REQUIRE(supernodal.factor(matrix));
+  REQUIRE(supernodal.refactor(matrix));
+  const Eigen::VectorXd x = supernodal.solve(Eigen::VectorXd::Ones(matrix.rows()));
+  CHECK(x.allFinite());
+  CHECK(process_threads() == before);
+  CHECK(get_levels() == 3);
 }
