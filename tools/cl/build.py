@@ -60,14 +60,18 @@ def quiet(command, what):
                           details=done.stdout.splitlines())
 
 
-def build_targets(targets, build_dir=None, log=sys.stdout, label=None):
-    """Build only `targets`; return the tools' output. Raise BuildFailure."""
+def build_targets(targets, build_dir=None, log=sys.stdout, label=None, keep_going=False):
+    """Build only `targets`; return the tools' output. Raise BuildFailure.
+    keep_going: build all that can be built past a failure (make -k)."""
     build_dir = build_dir or BUILD
     if log is not None:
         print(f"building {label or ' '.join(targets)}...", end=" ", file=log, flush=True)
     start = time.monotonic()
     try:
-        done = subprocess.run(["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets],
+        command = ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets]
+        if keep_going:
+            command += ["--", "-k"]
+        done = subprocess.run(command,
                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                               check=False)
     except FileNotFoundError:

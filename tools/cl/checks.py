@@ -22,7 +22,7 @@ from .labs import lab_dirs, lab_targets, manifest, reject_lines
 from .measure import check_measurements
 from .plots import run_plots
 from .release import is_release
-from .sanitize import check_sanitize
+from .sanitize import check_sanitize, start_sanitize
 from .student_loop import check_student_loop
 from .view import decode_positions, load_run, write_view
 
@@ -80,8 +80,14 @@ class Checks:
 
 
 def build_labs(checks, labs):
-    """Build each lab's targets on its own; return the labs that built."""
-    built = []
+    """Build each lab's targets on its own; return the labs that built. One
+    keep-going build of everything (CMake's `all`: the labs, common_tests and
+    the bench programs the later checks use) comes first: it keeps both cores
+    busy from the first file to the last, where lab-by-lab builds (CMake's
+    Makefile builds the targets it is given one after another) leave one idle
+    at the end of each. The builds per lab then only report; a lab that does
+    not compile blocks no other either way."""
+    wanted = {}
     for lab in labs:
         entry = manifest().get(lab)
         if entry is None:
@@ -90,9 +96,17 @@ def build_labs(checks, labs):
         targets = [lab, *lab_targets(lab)]
         if entry["reference"]:
             targets += [f"{lab}_solution", *lab_targets(lab, solutions=True)]
+        wanted[lab] = list(dict.fromkeys(targets))
+    with checks.timed("build everything (one keep-going build)"):
+        try:
+            build_targets(["all"], log=None, keep_going=True)
+        except BuildFailure:
+            pass  # each lab's own build below says which and why
+    built = []
+    for lab, targets in wanted.items():
         try:
             with checks.timed(f"build {lab}"):
-                build_targets(list(dict.fromkeys(targets)), log=None)
+                build_targets(targets, log=None)
         except BuildFailure as failure:
             checks.record(False, f"{lab} does not build", failure.lines)
             continue
@@ -473,6 +487,9 @@ def cmd_test(argv):
         fuzzing = check_fuzz(checks)
         if fuzzing:
             fuzzing()
+        # The sanitizer build compiles beside the checks up to the browser's,
+        # which mostly use one core (the fuzzer runs alone, above).
+        sanitizing = start_sanitize(checks)
         with checks.timed("honesty: the solutions graded"):
             check_solutions(checks, labs)
         with checks.timed("honesty: the stubs graded"):
@@ -482,7 +499,6 @@ def cmd_test(argv):
         with checks.timed("rejects"):
             check_rejects(checks, labs)
         check_measurements(checks, out)
-        check_sanitize(checks)
     with checks.timed("plots (every figure, redrawn)"):
         for script, outcome in run_plots(out, echo=False).items():
             checks.record(outcome.status in ("ok", "skipped") if is_release() else outcome.status == "ok",
@@ -493,6 +509,8 @@ def cmd_test(argv):
         with checks.timed("the view in a browser (headless Chromium)"):
             check_browser(checks)
     if not is_release():
+        if sanitizing is not None:
+            check_sanitize(checks, sanitizing)
         with checks.timed("student loop (a temporary release)"):
             check_student_loop(checks)
         with checks.timed("autograder (a bundle, five submissions)"):
