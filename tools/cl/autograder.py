@@ -27,7 +27,7 @@ import zipfile
 from pathlib import Path
 
 from . import grade
-from .base import BUILD, ROOT, CourseError, show
+from .base import BUILD, ROOT, CourseError, check_tree, show
 from .labs import lab_dirs, resolve_lab
 from .release import write_release
 TEMPLATES = ROOT / "tools" / "gradescope"
@@ -159,10 +159,9 @@ def check_autograder(checks, lab_token="lab02"):
         return
     broken = reference + "\nint this_line_does_not_compile = ;\n"
     start = time.monotonic()
-    with tempfile.TemporaryDirectory(prefix="cl-autograder-") as work:
-        root = Path(work) / "autograder"
+    with check_tree() as root:  # the student loop's tree was here too (check_tree)
         source = root / "source"
-        zip_path = Path(work) / f"{lab_token}.zip"
+        zip_path = root / f"{lab_token}.zip"
         write_bundle(lab, zip_path)
         unpack(zip_path, source)
         tree = source / "course"

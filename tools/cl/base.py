@@ -3,6 +3,8 @@
 Every module of the package but grade imports this one; it imports only grade.
 """
 import os
+import shutil
+from contextlib import contextmanager
 from pathlib import Path
 
 from . import grade
@@ -28,3 +30,20 @@ def show(path):
 
 def under_root(path):
     return ROOT / path  # an absolute `path` stays as it is
+
+
+@contextmanager
+def check_tree():
+    """A fresh folder for a check's temporary course tree, removed afterwards;
+    always the same path, BUILD/check-tree. ccache keys a compile on its
+    source's path, so the student loop's release and the autograder's bundle,
+    built there one after the other at the same relative places, share the
+    objects of the files they have in common (common/, labs 01 and 02)
+    instead of compiling them twice."""
+    path = BUILD / "check-tree"
+    shutil.rmtree(path, ignore_errors=True)
+    path.mkdir(parents=True)
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)

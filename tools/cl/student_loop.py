@@ -5,12 +5,10 @@ import re
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
-from pathlib import Path
 
 from . import grade
-from .base import ROOT
+from .base import ROOT, check_tree
 from .labs import lab_dirs
 from .release import advance_release, write_release
 
@@ -58,8 +56,8 @@ def check_student_loop(checks):
         checks.record(False, "student loop: cannot plant the bugs in solutions/lab01 (code changed?)")
         return
     start = time.monotonic()
-    with tempfile.TemporaryDirectory(prefix="cl-release-") as work:
-        tree = Path(work) / "release"
+    with check_tree() as work:
+        tree = work / "source" / "course"  # where the autograder check's tree will be (check_tree)
         write_release(lab3, tree)
         shipped = sorted(p.name for p in (tree / "solutions").iterdir())
         checks.record(shipped == [lab1, ids["lab02"]] and not (tree / "solutions" / lab3).exists(),
