@@ -60,6 +60,11 @@ def quiet(command, what):
                           details=done.stdout.splitlines())
 
 
+def build_command(targets, build_dir, keep_going=False):
+    """The command that builds `targets` in build_dir on both cores (make -k: past a failure)."""
+    return ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets, *(["--", "-k"] if keep_going else [])]
+
+
 def build_targets(targets, build_dir=None, log=sys.stdout, label=None, keep_going=False):
     """Build only `targets`; return the tools' output. Raise BuildFailure.
     keep_going: build all that can be built past a failure (make -k)."""
@@ -68,10 +73,7 @@ def build_targets(targets, build_dir=None, log=sys.stdout, label=None, keep_goin
         print(f"building {label or ' '.join(targets)}...", end=" ", file=log, flush=True)
     start = time.monotonic()
     try:
-        command = ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets]
-        if keep_going:
-            command += ["--", "-k"]
-        done = subprocess.run(command,
+        done = subprocess.run(build_command(targets, build_dir, keep_going),
                               cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                               check=False)
     except FileNotFoundError:

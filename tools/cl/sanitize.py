@@ -8,7 +8,7 @@ import time
 
 from . import grade
 from .base import BUILD, ROOT, CourseError
-from .build import BuildFailure, build_targets, configure, first_errors, quiet, sanitizer_env
+from .build import BuildFailure, build_command, build_targets, configure, first_errors, quiet, sanitizer_env
 from .labs import manifest
 
 SANITIZE_BUILD = BUILD / "asan"
@@ -29,7 +29,7 @@ def run_sanitized(log=sys.stdout):
 
 
 def configure_sanitized(log=sys.stdout):
-    """Configure the sanitizer build (once); return its test programs' names."""
+    """Configure the sanitizer build (when new or its flags changed); return its test programs' names."""
     configure(log=log)  # labs.json says which labs have a reference
     # Without precompiled headers: under -fsanitize and -g1 a file that loads
     # the header takes twice as long as one that parses its own includes
@@ -62,7 +62,7 @@ class BackgroundBuild:
         self.output = tempfile.TemporaryFile(mode="w+")
         self.started = time.monotonic()
         self.process = subprocess.Popen(
-            ["nice", "-n", "10", "cmake", "--build", str(SANITIZE_BUILD), "-j", "2", "--target", *self.targets],
+            ["nice", "-n", "10", *build_command(self.targets, SANITIZE_BUILD)],
             cwd=ROOT, stdout=self.output, stderr=subprocess.STDOUT, text=True)
         self.seconds = None
 
@@ -124,21 +124,17 @@ def start_sanitize(checks):
         return None
 
 
-def check_sanitize(checks, background=None):
-    """CI: the whole test suite under ASan and UBSan, clean. `background`: the
-    build started by start_sanitize, else it is built here."""
+def check_sanitize(checks, background):
+    """CI: the whole test suite under ASan and UBSan, clean; `background` is the
+    build start_sanitize started."""
     try:
-        if background is None:
-            with checks.timed("sanitize: build"):
-                targets = build_sanitized(log=None)
-        else:
-            with checks.timed("sanitize: waiting for its build"):
-                try:
-                    targets = background.finish()
-                finally:
-                    checks.add_time("sanitize: build (in the background, niced)", background.seconds or 0.0,
-                                    concurrent=True)
-    except (CourseError, BuildFailure) as error:
+        with checks.timed("sanitize: waiting for its build"):
+            try:
+                targets = background.finish()
+            finally:
+                checks.add_time("sanitize: build (in the background, niced)", background.seconds or 0.0,
+                                concurrent=True)
+    except BuildFailure as error:
         checks.record(False, f"sanitizer build: {error}", getattr(error, "lines", getattr(error, "details", [])))
         return
     with checks.timed("sanitize: runs"):
