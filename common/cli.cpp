@@ -5,6 +5,8 @@
 #include <sstream>
 #include <utility>
 
+#include <CLI/CLI.hpp>
+
 #include "common/not_implemented.h"
 #include "common/trajectory.h"
 

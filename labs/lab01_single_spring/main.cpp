@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <CLI/CLI.hpp>
+
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/metrics.h"

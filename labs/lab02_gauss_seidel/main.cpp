@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include <CLI/CLI.hpp>
+
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"

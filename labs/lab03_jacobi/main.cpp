@@ -13,6 +13,8 @@
 #include <string>
 #include <utility>
 
+#include <CLI/CLI.hpp>
+
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/output.h"

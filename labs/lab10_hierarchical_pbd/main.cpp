@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/hierarchy.h"

@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "accelerated.h"
 #include "common/cli.h"
 #include "common/csv.h"

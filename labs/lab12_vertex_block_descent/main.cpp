@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/driver.h"

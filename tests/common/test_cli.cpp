@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <map>
 
+#include <CLI/CLI.hpp>
 #include <catch2/catch.hpp>
 
 #include "common/cli.h"
