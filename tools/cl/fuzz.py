@@ -7,7 +7,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 
 from .base import BUILD, ROOT, CourseError, show
-from .build import BuildFailure, build_targets, quiet
+from .build import BuildFailure, build_targets, generator_args, quiet
 
 REGRESSIONS = ROOT / "tests" / "common" / "scene_regressions"
 
@@ -18,7 +18,8 @@ def build_fuzzer(log=sys.stdout):
     if shutil.which("clang++") is None:
         raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
     if not (fuzz_build / "CMakeCache.txt").is_file():
-        quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), "-DCMAKE_CXX_COMPILER=clang++",
+        quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), *generator_args(fuzz_build),
+               "-DCMAKE_CXX_COMPILER=clang++",
                "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], "configure fuzz/")
     build_targets(["fuzz_scene"], build_dir=fuzz_build, log=log)
     return fuzz_build / "fuzz_scene"

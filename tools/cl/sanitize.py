@@ -8,7 +8,8 @@ import time
 
 from . import grade
 from .base import BUILD, ROOT, CourseError
-from .build import BuildFailure, build_command, build_targets, configure, first_errors, quiet, sanitizer_env
+from .build import (BuildFailure, build_command, build_targets, configure, first_errors, generator_args, quiet,
+                    sanitizer_env)
 from .labs import manifest
 
 SANITIZE_BUILD = BUILD / "asan"
@@ -39,7 +40,8 @@ def configure_sanitized(log=sys.stdout):
     # 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
     cache = SANITIZE_BUILD / "CMakeCache.txt"
     if not cache.is_file() or f"CMAKE_CXX_FLAGS_RELWITHDEBINFO:STRING={SANITIZE_FLAGS}" not in cache.read_text():
-        quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), "-DCL_SANITIZE=ON", "-DCL_PCH=OFF",
+        quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), *generator_args(SANITIZE_BUILD),
+               "-DCL_SANITIZE=ON", "-DCL_PCH=OFF",
                "-DCMAKE_BUILD_TYPE=RelWithDebInfo", f"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO={SANITIZE_FLAGS}"],
               "configure the sanitizer build")
     return sanitize_targets()
