@@ -83,9 +83,8 @@ def build_labs(checks, labs):
     """Build each lab's targets on its own; return the labs that built. One
     keep-going build of everything (CMake's `all`: the labs, common_tests and
     the bench programs the later checks use) comes first: it keeps both cores
-    busy from the first file to the last, where lab-by-lab builds (CMake's
-    Makefile builds the targets it is given one after another) leave one idle
-    at the end of each. The builds per lab then only report; a lab that does
+    busy from the first file to the last, where lab-by-lab builds leave one
+    idle at the end of each. The builds per lab then only report; a lab that does
     not compile blocks no other either way. A student release skips it: its
     checks use no bench program."""
     wanted = {}
