@@ -137,7 +137,7 @@ def check_sanitize(checks, background):
                 checks.add_time("sanitize: build (in the background, niced)", background.seconds or 0.0,
                                 concurrent=True)
     except BuildFailure as error:
-        checks.record(False, f"sanitizer build: {error}", getattr(error, "lines", getattr(error, "details", [])))
+        checks.record(False, f"sanitizer build: {error}", error.lines)
         return
     with checks.timed("sanitize: runs"):
         results = run_programs(targets)
