@@ -23,7 +23,6 @@
 #include <omp.h>
 #endif
 
-#include <CLI/CLI.hpp>
 #include <Eigen/Core>
 
 #include "common/cli.h"
@@ -520,31 +519,30 @@ int run(const Options& options) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"The speed/accuracy trade: every method on shared scenes (bench/README.md)."};
-  app.name("trade");
+  cl::CommandLine app{"The speed/accuracy trade: every method on shared scenes (bench/README.md).", "trade"};
   Options options;
   app.add_flag("--quick", options.quick, "CI size: rope-100, curtain-16 and -32, fewer iterations, repeats and steps");
-  app.add_option("--out", options.out, "folder for the CSV files")->capture_default_str();
+  app.add_option("--out", options.out, "folder for the CSV files").capture_default_str();
   app.add_option("--scenes", options.scenes, "rope-100, curtain-N (default: rope-100 and curtains 16 to 128)")
-      ->delimiter(',');
+      .delimiter(',');
   app.add_option("--methods", options.methods,
                  "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, pd-chebyshev, pd-lbfgs, jacobi-chebyshev, "
                  "vbd, vbd-chebyshev")
-      ->delimiter(',');
+      .delimiter(',');
   app.add_option("--stiffness", options.stiffness, "every spring's stiffness, N/m")
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .positive()
+      .capture_default_str();
   app.add_option("--repeats", options.repeats, "timed repeats of each step (default 5, quick 3)")
-      ->check(CLI::PositiveNumber);
+      .range(1, 1'000'000);
   app.add_option("--horizon", options.horizon, "steps of the energy-drift run (default 20, quick 10)")
-      ->check(CLI::PositiveNumber);
+      .range(1, 1'000'000);
   app.add_option("--warmup", options.warmup, "PD steps (100 iterations) before the shared start (default 10, quick 5)")
-      ->check(CLI::PositiveNumber);
+      .range(1, 1'000'000);
   app.add_option("--step-cap", options.step_cap, "stop raising K once a step takes this long, s (default 0.3, quick 0.05)")
-      ->check(cl::finite_number(false));
+      .positive();
   app.add_option("--threads", options.threads,
                  "OpenMP threads of the parallel sweeps and BLAS threads of CHOLMOD (1: comparable timings on a shared machine)")
-      ->check(CLI::Range(1, 256))
-      ->capture_default_str();
+      .range(1, 256)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options); });
 }

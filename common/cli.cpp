@@ -88,6 +88,98 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
   }
 }
 
+Option& Option::range(long long low, long long high) {
+  option_->check(CLI::Range(low, high));
+  return *this;
+}
+
+Option& Option::one_of(const std::vector<std::string>& words) {
+  option_->check(CLI::IsMember(words));
+  return *this;
+}
+
+Option& Option::positive() {
+  option_->check(finite_number(false));
+  return *this;
+}
+
+Option& Option::non_negative() {
+  option_->check(finite_number(true));
+  return *this;
+}
+
+Option& Option::finite_in(double low, double high) {
+  option_->check(cl::finite_in(low, high));
+  return *this;
+}
+
+Option& Option::delimiter(char separator) {
+  option_->delimiter(separator);
+  return *this;
+}
+
+Option& Option::capture_default_str() {
+  option_->capture_default_str();
+  return *this;
+}
+
+Option& Option::description(const std::string& text) {
+  option_->description(text);
+  return *this;
+}
+
+Option& Option::excludes(const Option& other) {
+  option_->excludes(other.option_);
+  return *this;
+}
+
+CommandLine::CommandLine(const std::string& description, const std::string& program_name)
+    : app_(std::make_unique<CLI::App>(description, program_name)) {}
+
+CommandLine::~CommandLine() = default;
+
+Option CommandLine::add_option(const std::string& name, std::string& value, const std::string& help) {
+  return Option(app_->add_option(name, value, help));
+}
+
+Option CommandLine::add_option(const std::string& name, int& value, const std::string& help) {
+  return Option(app_->add_option(name, value, help));
+}
+
+Option CommandLine::add_option(const std::string& name, long long& value, const std::string& help) {
+  return Option(app_->add_option(name, value, help));
+}
+
+Option CommandLine::add_option(const std::string& name, double& value, const std::string& help) {
+  return Option(app_->add_option(name, value, help));
+}
+
+Option CommandLine::add_option(const std::string& name, std::optional<double>& value, const std::string& help) {
+  return Option(app_->add_option(name, value, help));
+}
+
+Option CommandLine::add_option(const std::string& name, std::vector<int>& values, const std::string& help) {
+  return Option(app_->add_option(name, values, help));
+}
+
+Option CommandLine::add_option(const std::string& name, std::vector<double>& values, const std::string& help) {
+  return Option(app_->add_option(name, values, help));
+}
+
+Option CommandLine::add_option(const std::string& name, std::vector<std::string>& values, const std::string& help) {
+  return Option(app_->add_option(name, values, help));
+}
+
+Option CommandLine::add_flag(const std::string& name, bool& value, const std::string& help) {
+  return Option(app_->add_flag(name, value, help));
+}
+
+Option CommandLine::get_option(const std::string& name) { return Option(app_->get_option(name)); }
+
+void add_common_options(CommandLine& line, CommonOptions& options, unsigned flags) {
+  add_common_options(line.app(), options, flags);
+}
+
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir) {
   Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir));
   if (options.dt > 0.0) scene.dt = options.dt;
@@ -154,6 +246,11 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
     std::cerr << program << ": error: " << error.what() << "\n";
     return noting(1, program, student_earlier_labs);
   }
+}
+
+int run_main(CommandLine& line, int argc, char** argv, const std::function<int()>& body,
+             const char* student_earlier_labs) {
+  return run_main(line.app(), argc, argv, body, student_earlier_labs);
 }
 
 }  // namespace cl

@@ -5,8 +5,6 @@
 #include <cstdio>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/metrics.h"
@@ -117,8 +115,9 @@ int run(const cl::CommonOptions& options, bool sweep) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 01: project every spring of a scene once and measure the strain before and after.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 01: project every spring of a scene once and measure the strain before and after.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "two-particles";
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagOut | cl::kFlagSummary);

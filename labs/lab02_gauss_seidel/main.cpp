@@ -8,8 +8,6 @@
 #include <optional>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"
@@ -155,26 +153,27 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 02: Gauss-Seidel sweeps over a scene's springs; strain error and position change per sweep.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 02: Gauss-Seidel sweeps over a scene's springs; strain error and position change per sweep.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "perturbed-chain";
   options.iterations = 100;
   options.frames_are_sweeps = true;
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
-  app.get_option("--iterations")->description("Gauss-Seidel sweeps over all springs (this lab has no time steps)");
+  app.get_option("--iterations").description("Gauss-Seidel sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   const std::vector<std::string> orders{"forward", "reverse", "random"};
   app.add_option("--order", lab.order, "spring order of every sweep (random: a new shuffle per sweep)")
-      ->check(CLI::IsMember(orders))
-      ->capture_default_str();
-  app.add_option("--seed", lab.seed, "seed of the random order")->check(CLI::Range(0LL, 2'000'000'000LL))
-      ->capture_default_str();
+      .one_of(orders)
+      .capture_default_str();
+  app.add_option("--seed", lab.seed, "seed of the random order").range(0, 2'000'000'000)
+      .capture_default_str();
   app.add_option("--compare", lab.compare, "also run the same sweeps in this order and compare the final states")
-      ->check(CLI::IsMember(orders));
+      .one_of(orders);
   app.add_option("--tolerance", lab.tolerance, "max strain error that counts as converged")
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .positive()
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

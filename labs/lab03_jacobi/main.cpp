@@ -13,8 +13,6 @@
 #include <string>
 #include <utility>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/output.h"
@@ -152,9 +150,10 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 03: Jacobi sweeps (or Gauss-Seidel, for comparison) over a scene's springs; strain error, "
-               "position change and wall time per sweep.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 03: Jacobi sweeps (or Gauss-Seidel, for comparison) over a scene's springs; strain error, "
+      "position change and wall time per sweep.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options;
   options.scene = "chain-20";
   options.iterations = 100;
@@ -164,21 +163,21 @@ int main(int argc, char** argv) {
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary |
                              cl::kFlagFrames);
-  app.get_option("--iterations")->description("sweeps over all springs (this lab has no time steps)");
+  app.get_option("--iterations").description("sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
   lab.threads = omp_get_max_threads();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor (0 leaves x unchanged; >= 2 diverges)")
-      ->check(cl::finite_number(true))
-      ->capture_default_str();
+      .non_negative()
+      .capture_default_str();
   app.add_option("--threads", lab.threads, "OpenMP threads for the Jacobi sweep")
-      ->check(CLI::Range(1, 1024))
-      ->capture_default_str();
+      .range(1, 1024)
+      .capture_default_str();
   app.add_option("--averaging", lab.averaging,
                  "count: divide each particle's summed correction by its spring count; none: plain summed Jacobi")
-      ->check(CLI::IsMember({"count", "none"}))
-      ->capture_default_str();
+      .one_of({"count", "none"})
+      .capture_default_str();
   app.add_option("--tolerance", lab.tolerance, "max strain error that counts as converged")
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .positive()
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -9,8 +9,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"
@@ -127,51 +125,52 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
-               "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 04: position based dynamics. Runs a scene and writes per-frame strain and energy, OBJ "
+      "frames and a summary; or sweeps iterations or substeps and writes the steady strain.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("curtain-16", "gauss-seidel", {"gauss-seidel", "jacobi"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   app.get_option("--frames")
-      ->description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
-                    "mesh into OUT/frames/");
+      .description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
+                   "mesh into OUT/frames/");
   LabOptions lab;
   app.add_option("--substeps", lab.substeps, "PBD steps of dt/n per frame")
-      ->check(CLI::Range(1, 1'000'000))
-      ->capture_default_str();
+      .range(1, 1'000'000)
+      .capture_default_str();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor ω, as in lab 03 (0 leaves x unchanged; >= 2 diverges)")
-      ->check(cl::finite_number(true))
-      ->capture_default_str();
+      .non_negative()
+      .capture_default_str();
   app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady strain")
-      ->check(cl::finite_in(1e-9, 1e9))
-      ->capture_default_str();
-  CLI::Option* iterations_sweep =
+      .finite_in(1e-9, 1e9)
+      .capture_default_str();
+  cl::Option iterations_sweep =
       app.add_option("--sweep-iterations", lab.sweep_iterations,
                      "run the scene(s) once per K in this list (e.g. 1,2,4,8) and write strain_vs_iterations.csv; "
                      "--steps is then the most frames a run may take to settle")
-          ->delimiter(',')
-          ->check(CLI::Range(0, 1'000'000));
-  CLI::Option* substeps_sweep =
+          .delimiter(',')
+          .range(0, 1'000'000);
+  cl::Option substeps_sweep =
       app.add_option("--sweep-substeps", lab.sweep_substeps,
                      "run the scene(s) once per substep count n in this list with K = C/n (--cost C) and write "
                      "substeps.csv")
-          ->delimiter(',')
-          ->check(CLI::Range(1, 1'000'000));
-  iterations_sweep->excludes(substeps_sweep);
+          .delimiter(',')
+          .range(1, 1'000'000);
+  iterations_sweep.excludes(substeps_sweep);
   app.add_option("--cost", lab.cost, "substeps × iterations, fixed across --sweep-substeps")
-      ->check(CLI::Range(1, 100'000'000));
+      .range(1, 100'000'000);
   app.add_option("--sweep-scenes", lab.sweep_scenes,
                  "scenes for a sweep (default: --scene), e.g. curtain-8,curtain-16")
-      ->delimiter(',');
+      .delimiter(',');
   app.add_option("--settle-tolerance", lab.settle_tolerance,
                  "sweeps: a run has settled when the mean max strain of its last three windows agree to this "
                  "relative spread (0: run all --steps frames)")
-      ->check(cl::finite_in(0.0, 1e9))
-      ->capture_default_str();
+      .finite_in(0.0, 1e9)
+      .capture_default_str();
   app.add_option("--energy-seconds", lab.energy_seconds, "sweeps: compare the total energy at this time")
-      ->check(cl::finite_in(0.0, 1e9))
-      ->capture_default_str();
+      .finite_in(0.0, 1e9)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

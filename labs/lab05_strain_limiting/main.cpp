@@ -9,8 +9,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"
@@ -117,42 +115,43 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 05: strain limiting. Steps a mass-spring scene explicitly and limits the strain of its springs "
-               "or triangles to [sigma-min, sigma-max] after every step; writes per-step strain and energy and a "
-               "summary. Or compares the limiters, or maps stability over stiffness and dt.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 05: strain limiting. Steps a mass-spring scene explicitly and limits the strain of its springs "
+      "or triangles to [sigma-min, sigma-max] after every step; writes per-step strain and energy and a "
+      "summary. Or compares the limiters, or maps stability over stiffness and dt.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("soft-curtain-32");
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--limit", lab.limit, "the limiter run after each step")
-      ->check(CLI::IsMember({"none", "springs", "triangles-area", "triangles-stretch"}))
-      ->capture_default_str();
+      .one_of({"none", "springs", "triangles-area", "triangles-stretch"})
+      .capture_default_str();
   app.add_option("--sigma-min", lab.sigma_min, "lower bound of the band for l/L (> 0)")
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .positive()
+      .capture_default_str();
   app.add_option("--sigma-max", lab.sigma_max, "upper bound of the band for l/L (>= sigma-min)")
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .positive()
+      .capture_default_str();
   app.add_option("--compare-limits", lab.compare_limits,
                  "run the scene once per limiter in this list (e.g. none,springs,triangles-area,triangles-stretch) "
                  "and write strain_vs_time.csv, compare_limits.csv and shapes.csv")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"none", "springs", "triangles-area", "triangles-stretch"}));
+      .delimiter(',')
+      .one_of({"none", "springs", "triangles-area", "triangles-stretch"});
   app.add_flag("--stability-map", lab.stability_map,
                "run the scene at every (--map-stiffness, --map-dt) pair, without a limiter and, where that blows "
                "up, with --limit; write stability_map.csv");
   app.add_option("--map-stiffness", lab.map_stiffness, "spring stiffnesses (N/m) for --stability-map")
-      ->delimiter(',')
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .delimiter(',')
+      .positive()
+      .capture_default_str();
   app.add_option("--map-dt", lab.map_dt, "time steps (s) for --stability-map")
-      ->delimiter(',')
-      ->check(cl::finite_number(false))
-      ->capture_default_str();
+      .delimiter(',')
+      .positive()
+      .capture_default_str();
   app.add_option("--map-seconds", lab.map_seconds, "simulated time per --stability-map run (s)")
-      ->check(cl::finite_in(1e-9, 1e6))
-      ->capture_default_str();
+      .finite_in(1e-9, 1e6)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

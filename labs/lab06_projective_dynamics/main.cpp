@@ -13,8 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"
@@ -122,10 +120,11 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 06: projective dynamics against Newton on the implicit-Euler objective. Runs a scene and "
-               "writes per-step objective, iterations, time and strain and a summary; or (--convergence) one "
-               "step of each method to its minimum and writes the convergence curves.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 06: projective dynamics against Newton on the implicit-Euler objective. Runs a scene and "
+      "writes per-step objective, iterations, time and strain and a summary; or (--convergence) one "
+      "step of each method to its minimum and writes the convergence curves.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("pd-curtain-16", "pd", {"pd", "newton"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
@@ -133,31 +132,31 @@ int main(int argc, char** argv) {
   LabOptions lab;
   app.add_option("--tolerance", lab.tolerance,
                  "stop a step's iterations once the objective's relative decrease falls below this (0: run all K)")
-      ->check(cl::finite_number(true))
-      ->capture_default_str();
+      .non_negative()
+      .capture_default_str();
   app.add_option("--stiffness", lab.stiffness, "replace every spring's stiffness (N/m)")
-      ->check(cl::finite_number(false));
+      .positive();
   app.add_flag("--convergence", lab.convergence,
                "one step of each method to the minimum: convergence.csv and crossover.csv");
   app.add_option("--warmup", lab.warmup, "--convergence: PD steps (K = --iterations) before the measured step")
-      ->check(CLI::Range(0, 1'000'000))
-      ->capture_default_str();
+      .range(0, 1'000'000)
+      .capture_default_str();
   app.add_option("--pd-cap", lab.pd_cap, "--convergence: the most PD iterations")
-      ->check(CLI::Range(1, 100'000'000))
-      ->capture_default_str();
+      .range(1, 100'000'000)
+      .capture_default_str();
   app.add_option("--newton-cap", lab.newton_cap, "--convergence: the most Newton iterations")
-      ->check(CLI::Range(1, 1'000'000))
-      ->capture_default_str();
+      .range(1, 1'000'000)
+      .capture_default_str();
   app.add_option("--stop-gap", lab.stop_gap,
                  "--convergence: end the PD run once its relative objective error (g - g*)/g*, g* Newton's "
                  "minimum, is this small")
-      ->check(cl::finite_in(0.0, 1.0))
-      ->capture_default_str();
+      .finite_in(0.0, 1.0)
+      .capture_default_str();
   app.add_option("--max-seconds", lab.max_seconds,
                  "--convergence: end a run after this many seconds of wall time (0: no limit)")
-      ->check(cl::finite_number(true))
-      ->capture_default_str();
+      .non_negative()
+      .capture_default_str();
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)")
-      ->delimiter(',');
+      .delimiter(',');
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

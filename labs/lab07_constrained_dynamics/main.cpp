@@ -10,8 +10,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/frame_loop.h"
@@ -165,10 +163,11 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 07: constrained dynamics. Implicit Euler with linearised distance constraints, solved as one "
-               "KKT system or by its Schur complement; writes per-frame constraint error and energy and a summary "
-               "with the multipliers. Or compares PBD (lab 04) with both solves on one scene.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 07: constrained dynamics. Implicit Euler with linearised distance constraints, solved as one "
+      "KKT system or by its Schur complement; writes per-frame constraint error and energy and a summary "
+      "with the multipliers. Or compares PBD (lab 04) with both solves on one scene.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("ragdoll-chain-20", "schur", {"kkt", "schur"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
@@ -178,15 +177,15 @@ int main(int argc, char** argv) {
                "after every step, project the positions once onto the hard constraints (velocities unchanged)");
   app.add_option("--regularize", lab.regularize,
                  "compliance (m/N) added to every hard constraint, e.g. 1e-9: a way out of a singular system")
-      ->check(cl::finite_number(true));
+      .non_negative();
   app.add_option("--stiffness", lab.stiffness, "replace every spring's stiffness: a number (N/m) or inf");
   app.add_option("--compare-pbd", lab.compare_pbd,
                  "compare: PBD (lab 04, Gauss-Seidel) with these iteration counts, one substep; writes compare.csv")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 1'000'000));
+      .delimiter(',')
+      .range(1, 1'000'000);
   app.add_option("--compare-substeps", lab.compare_substeps,
                  "compare: the KKT and Schur steps (and PBD with one iteration) at these substeps per frame")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 1'000'000));
+      .delimiter(',')
+      .range(1, 1'000'000);
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -8,8 +8,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/metrics.h"
@@ -124,30 +122,31 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 08: XPBD. Runs a scene with PBD (lab 04) or XPBD and writes per-frame strain, stretch and "
-               "energy and a summary with the multipliers; or sweeps the iteration count and writes the steady "
-               "stretch.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 08: XPBD. Runs a scene with PBD (lab 04) or XPBD and writes per-frame strain, stretch and "
+      "energy and a summary with the multipliers; or sweeps the iteration count and writes the steady "
+      "stretch.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("hanging-chain-20", "xpbd", {"pbd", "xpbd"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   app.add_option("--substeps", lab.substeps, "steps of dt/n per frame")
-      ->check(CLI::Range(1, 1'000'000))
-      ->capture_default_str();
+      .range(1, 1'000'000)
+      .capture_default_str();
   app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady stretch")
-      ->check(cl::finite_in(1e-9, 1e9))
-      ->capture_default_str();
+      .finite_in(1e-9, 1e9)
+      .capture_default_str();
   app.add_option("--sweep-iterations", lab.sweep_iterations,
                  "run the scene once per K in this list (e.g. 1,2,4,8) and write "
                  "stretch_vs_iterations_<method>.csv; --steps is then the most frames a run may take to settle")
-      ->delimiter(',')
-      ->check(CLI::Range(0, 1'000'000));
+      .delimiter(',')
+      .range(0, 1'000'000);
   app.add_option("--settle-tolerance", lab.settle_tolerance,
                  "sweeps: a run has settled when the mean total stretch of its last three windows agree to this "
                  "relative spread (0: run all --steps frames)")
-      ->check(cl::finite_in(0.0, 1e9))
-      ->capture_default_str();
+      .finite_in(0.0, 1e9)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -14,8 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/driver.h"
@@ -149,11 +147,12 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 09: stable constrained dynamics. Lab 07's step with the geometric stiffness of the distance "
-               "constraints, solved as one KKT system or by a Schur complement; writes per-frame constraint error, "
-               "transverse speed and energy and a summary with the multipliers. Or measures the largest stable "
-               "dt of a heavy chain against its mass ratio, with and without the geometric stiffness.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 09: stable constrained dynamics. Lab 07's step with the geometric stiffness of the distance "
+      "constraints, solved as one KKT system or by a Schur complement; writes per-frame constraint error, "
+      "transverse speed and energy and a summary with the multipliers. Or measures the largest stable "
+      "dt of a heavy chain against its mass ratio, with and without the geometric stiffness.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("heavy-chain-1000", "schur", {"schur", "kkt"});
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
@@ -161,32 +160,32 @@ int main(int argc, char** argv) {
   LabOptions lab;
   app.add_option("--geometric-stiffness", lab.geometric_stiffness,
                  "add K_g to the step (on) or not (off: lab 07's step)")
-      ->check(CLI::IsMember({"on", "off"}))
-      ->capture_default_str();
+      .one_of({"on", "off"})
+      .capture_default_str();
   app.add_option("--compression", lab.compression,
                  "compressed constraints (lambda > 0) in K_g: drop them (always SPD) or keep them (exact, may be "
                  "indefinite)")
-      ->check(CLI::IsMember({"drop", "keep"}))
-      ->capture_default_str();
+      .one_of({"drop", "keep"})
+      .capture_default_str();
   app.add_option("--regularize", lab.regularize,
                  "compliance (m/N) added to every hard constraint, as in lab 07 (e.g. 1e-9)")
-      ->check(cl::finite_number(true));
+      .non_negative();
   app.add_option("--sweep-mass-ratios", lab.sweep_mass_ratios,
                  "experiment: for each mass ratio (e.g. 1,10,100) find the largest stable dt of the heavy chain "
                  "with and without K_g; writes stability.csv and stability_runs.csv")
-      ->delimiter(',')
-      ->check(cl::finite_in(1e-6, 1e12));
+      .delimiter(',')
+      .finite_in(1e-6, 1e12);
   app.add_option("--sweep-dt-min", lab.sweep_dt_min, "experiment: the smallest dt tried (s)")
-      ->check(cl::finite_in(1e-7, 10.0))
-      ->capture_default_str();
+      .finite_in(1e-7, 10.0)
+      .capture_default_str();
   app.add_option("--sweep-dt-max", lab.sweep_dt_max, "experiment: the largest dt tried (s)")
-      ->check(cl::finite_in(1e-7, 10.0))
-      ->capture_default_str();
+      .finite_in(1e-7, 10.0)
+      .capture_default_str();
   app.add_option("--sweep-per-decade", lab.sweep_per_decade, "experiment: dt values per decade")
-      ->check(CLI::Range(1, 1000))
-      ->capture_default_str();
+      .range(1, 1000)
+      .capture_default_str();
   app.add_option("--sweep-links", lab.sweep_links, "experiment: links in the chain")
-      ->check(CLI::Range(2, 10000))
-      ->capture_default_str();
+      .range(2, 10000)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -12,8 +12,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/hierarchy.h"
@@ -116,43 +114,44 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 10: hierarchical position based dynamics on a cloth. Runs a scene with a coarse-to-fine "
-               "projection, or (--converge) counts the projections one step needs to reach a strain target.",
-               CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 10: hierarchical position based dynamics on a cloth. Runs a scene with a coarse-to-fine "
+      "projection, or (--converge) counts the projections one step needs to reach a strain target.",
+      CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("flat-curtain-64");
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary |
                              cl::kFlagFrames);
   app.get_option("--frames")
-      ->description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
-                    "mesh into OUT/frames/");
+      .description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
+                   "mesh into OUT/frames/");
   LabOptions lab;
   app.add_option("--levels", lab.levels, "levels of the hierarchy (1: plain Gauss-Seidel PBD)")
-      ->check(CLI::Range(1, 16))
-      ->capture_default_str();
+      .range(1, 16)
+      .capture_default_str();
   app.add_option("--iterations-per-level", lab.iterations_per_level,
                  "Gauss-Seidel sweeps on each level: one count for all, or one per level, the cloth first "
                  "(--converge: the sweeps on each coarse level)")
-      ->delimiter(',')
-      ->check(CLI::Range(0, 1'000'000))
-      ->capture_default_str();
+      .delimiter(',')
+      .range(0, 1'000'000)
+      .capture_default_str();
   app.add_flag("--converge", lab.converge,
                "experiment 1: one step from rest, count the projections to each --targets max strain");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--converge: scenes to measure (default: --scene)")
-      ->delimiter(',');
+      .delimiter(',');
   app.add_option("--sweep-levels", lab.sweep_levels, "--converge: level counts to measure (default: --levels)")
-      ->delimiter(',')
-      ->check(CLI::Range(1, 16));
+      .delimiter(',')
+      .range(1, 16);
   app.add_option("--targets", lab.targets, "--converge: max strain targets")
-      ->delimiter(',')
-      ->check(cl::finite_in(1e-12, 1e3))
-      ->capture_default_str();
+      .delimiter(',')
+      .finite_in(1e-12, 1e3)
+      .capture_default_str();
   app.add_option("--max-sweeps", lab.max_sweeps, "--converge: the most cloth sweeps per measurement")
-      ->check(CLI::Range(0, 100'000'000))
-      ->capture_default_str();
+      .range(0, 100'000'000)
+      .capture_default_str();
   app.add_option("--max-projections", lab.max_projections,
                  "--converge: also stop once the cloth sweeps alone reach this many projections (0: no limit)")
-      ->check(cl::finite_in(0.0, 1e15))
-      ->capture_default_str();
+      .finite_in(0.0, 1e15)
+      .capture_default_str();
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

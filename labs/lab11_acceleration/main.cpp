@@ -11,8 +11,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "accelerated.h"
 #include "common/cli.h"
 #include "common/csv.h"
@@ -164,8 +162,9 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 11: projective dynamics accelerated by Chebyshev and by L-BFGS on PD's matrix, and Jacobi PBD "
-               "by Chebyshev. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 11: projective dynamics accelerated by Chebyshev and by L-BFGS on PD's matrix, and Jacobi PBD "
+      "by Chebyshev. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults(
       "pd-curtain-16", "pd-chebyshev",
       {"pd", "pd-chebyshev", "pd-lbfgs", "newton", "jacobi", "jacobi-chebyshev", "gauss-seidel"});
@@ -175,22 +174,22 @@ int main(int argc, char** argv) {
   LabOptions lab;
   double rho = -1.0;
   app.add_option("--rho", rho, "the spectral radius for Chebyshev, in [0, 1) (default: estimated per scene)")
-      ->check(cl::finite_number(true));
+      .non_negative();
   app.add_option("--gamma", lab.settings.gamma, "Chebyshev's under-relaxation, in (0, 2)")
-      ->check(cl::finite_number(false))->capture_default_str();
+      .positive().capture_default_str();
   app.add_option("--delay", lab.settings.delay, "S: plain iterations before Chebyshev starts (>= 1)")
-      ->check(CLI::Range(1, 1'000'000))->capture_default_str();
+      .range(1, 1'000'000).capture_default_str();
   app.add_option("--history", lab.settings.history, "m: L-BFGS pairs kept (>= 0)")
-      ->check(CLI::Range(0, 1000))->capture_default_str();
+      .range(0, 1000).capture_default_str();
   app.add_option("--tolerance", lab.settings.tolerance,
                  "stop a step once the objective's relative decrease falls below this (0: run all K; PD methods)")
-      ->check(cl::finite_number(true))->capture_default_str();
+      .non_negative().capture_default_str();
   app.add_option("--estimate-iterations", lab.estimate_iterations, "plain iterations that estimate rho (no --rho)")
-      ->check(CLI::Range(2, 1'000'000))->capture_default_str();
+      .range(2, 1'000'000).capture_default_str();
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
-  app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)")->delimiter(',');
+  app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   app.add_option("--strain-target", lab.strain_target, "--convergence, PBD methods: the max strain to reach")
-      ->check(cl::finite_number(false))->capture_default_str();
+      .positive().capture_default_str();
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1) (the iteration would not converge)");
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");

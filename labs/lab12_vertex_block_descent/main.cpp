@@ -13,8 +13,6 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/driver.h"
@@ -157,8 +155,9 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"Lab 12: the implicit-Euler step by vertex block descent (Chen et al. 2024), plain or with Chebyshev "
-               "acceleration. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
+  cl::CommandLine app{
+      "Lab 12: the implicit-Euler step by vertex block descent (Chen et al. 2024), plain or with Chebyshev "
+      "acceleration. Runs a scene, or (--convergence) one step of it to the minimum.", CL_PROGRAM_NAME};
   cl::CommonOptions options = cl::lab_defaults("pd-curtain-16", "vbd", {"vbd", "vbd-chebyshev"});
   options.iterations = 10;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
@@ -166,17 +165,17 @@ int main(int argc, char** argv) {
   LabOptions lab;
   double rho = -1.0;
   app.add_option("--init", lab.init, "the first iterate: inertia (y) or adaptive (Chen et al. 2024)")
-      ->check(CLI::IsMember({"inertia", "adaptive"}))->capture_default_str();
+      .one_of({"inertia", "adaptive"}).capture_default_str();
   app.add_option("--tolerance", lab.settings.tolerance,
                  "stop a step once the objective's relative decrease falls below this (0: run every sweep)")
-      ->check(cl::finite_number(true))->capture_default_str();
-  app.add_option("--threads", lab.threads, "OpenMP threads for the sweep")->check(CLI::Range(1, 1024))->capture_default_str();
+      .non_negative().capture_default_str();
+  app.add_option("--threads", lab.threads, "OpenMP threads for the sweep").range(1, 1024).capture_default_str();
   app.add_option("--rho", rho, "vbd-chebyshev: the spectral radius, in [0, 1) (default: estimated per scene)")
-      ->check(cl::finite_number(true));
+      .non_negative();
   app.add_option("--estimate-iterations", lab.estimate_iterations, "plain sweeps that estimate rho (no --rho)")
-      ->check(CLI::Range(2, 1'000'000))->capture_default_str();
+      .range(2, 1'000'000).capture_default_str();
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
-  app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)")->delimiter(',');
+  app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
