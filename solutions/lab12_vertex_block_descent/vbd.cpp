@@ -8,6 +8,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 namespace cl::lab12 {
 
@@ -105,13 +108,25 @@ void vbd_sweep(const lab06::Problem& problem, const Adjacency& adjacency, const 
   const Eigen::Index n = problem.inv_mass.size();
   require_shape(x, n, "vbd_sweep: x");
   require_shape(y, n, "vbd_sweep: y");
-  for (const std::vector<int>& group : groups) {
-    const int size = static_cast<int>(group.size());
-#pragma omp parallel for schedule(static)
-    for (int g = 0; g < size; ++g) {
-      const int p = group[static_cast<std::size_t>(g)];
-      x.col(p) += vertex_update(vertex_block(problem, adjacency, x, y, p), problem.inv_mass[p]);
+  const auto update = [&](int p) {
+    x.col(p) += vertex_update(vertex_block(problem, adjacency, x, y, p), problem.inv_mass[p]);
+  };
+#ifdef _OPENMP
+  // One team per sweep and a barrier per colour. On one thread no team at
+  // all: libgomp's barrier makes a system call even for a team of one, which
+  // on a small mesh cost more than the sweep (the extremes' VBD cells).
+  if (omp_get_max_threads() > 1) {
+#pragma omp parallel
+    for (const std::vector<int>& group : groups) {
+      const int size = static_cast<int>(group.size());
+#pragma omp for schedule(static)
+      for (int g = 0; g < size; ++g) update(group[static_cast<std::size_t>(g)]);
     }
+    return;
+  }
+#endif
+  for (const std::vector<int>& group : groups) {
+    for (const int p : group) update(p);
   }
 }
 
