@@ -489,8 +489,11 @@ def cmd_test(argv):
         fuzzing = check_fuzz(checks)
         if fuzzing:
             fuzzing()
-        # The sanitizer build compiles beside the checks up to the browser's,
-        # which mostly use one core (the fuzzer runs alone, above).
+        # The sanitizer build compiles, then runs the suite, in the background,
+        # niced, beside every check after the fuzzer's (which runs alone,
+        # above): those leave a core or part of one free most of the time,
+        # the student loop's and the autograder's builds too. Its results
+        # are waited for last.
         sanitizing = start_sanitize(checks)
         with checks.timed("honesty: the solutions graded"):
             check_solutions(checks, labs)
@@ -511,10 +514,10 @@ def cmd_test(argv):
         with checks.timed("the view in a browser (headless Chromium)"):
             check_browser(checks)
     if not is_release():
-        if sanitizing is not None:
-            check_sanitize(checks, sanitizing)
         with checks.timed("student loop (a temporary release)"):
             check_student_loop(checks)
         with checks.timed("autograder (a bundle, five submissions)"):
             check_autograder(checks)
+        if sanitizing is not None:
+            check_sanitize(checks, sanitizing)
     return checks.finish()

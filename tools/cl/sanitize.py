@@ -1,9 +1,13 @@
 """./course sanitize: the whole test suite under ASan and UBSan (build/asan), and its CI check."""
 import argparse
+import atexit
 from concurrent.futures import ThreadPoolExecutor
+import os
+import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 
 from . import grade
@@ -54,46 +58,69 @@ def build_sanitized(log=sys.stdout):
     return targets
 
 
-class BackgroundBuild:
-    """The sanitizer build's compile, started now and waited for later (./course
-    test runs it beside the checks that use one core: the grading, the demo,
-    the plots). Niced, so that those checks keep their core."""
+class BackgroundSuite:
+    """The sanitizer build's compile and then its runs, started now and waited
+    for at the end (./course test runs them beside its other checks). Niced,
+    so that those checks keep the cores they use; stopped if ./course test
+    ends first."""
 
     def __init__(self):
         self.targets = configure_sanitized(log=None)
+        self.build_seconds = None
+        self.run_seconds = None
+        self.results = None
+        self.error = None
         self.output = tempfile.TemporaryFile(mode="w+")
         self.started = time.monotonic()
         self.process = subprocess.Popen(
             ["nice", "-n", "10", *build_command(self.targets, SANITIZE_BUILD)],
-            cwd=ROOT, stdout=self.output, stderr=subprocess.STDOUT, text=True)
-        self.seconds = None
+            cwd=ROOT, stdout=self.output, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+        atexit.register(self.stop)
+        self.thread = threading.Thread(target=self.work, daemon=True)
+        self.thread.start()
+
+    def work(self):
+        try:
+            code = self.process.wait()
+            self.build_seconds = time.monotonic() - self.started
+            self.output.seek(0)
+            text = self.output.read()
+            self.output.close()
+            if code != 0:
+                raise BuildFailure(self.targets, first_errors(text))
+            start = time.monotonic()
+            self.results = run_programs(self.targets, nice=True)
+            self.run_seconds = time.monotonic() - start
+        except BaseException as error:  # handed to finish(), in the main thread
+            self.error = error
+
+    def stop(self):
+        if self.process.poll() is None:
+            os.killpg(self.process.pid, signal.SIGTERM)
 
     def finish(self):
-        """Wait for the build; return the targets or raise BuildFailure."""
-        code = self.process.wait()
-        self.seconds = time.monotonic() - self.started
-        self.output.seek(0)
-        text = self.output.read()
-        self.output.close()
-        if code != 0:
-            raise BuildFailure(self.targets, first_errors(text))
-        return self.targets
+        """Wait for the build and the runs; return [(program, ok, summary line,
+        report lines)] or raise what stopped them (BuildFailure for the build)."""
+        self.thread.join()
+        if self.error is not None:
+            raise self.error
+        return self.results
 
 
-def run_programs(targets):
+def run_programs(targets, nice=False):
     """Run each sanitizer-built test program, every case: [(program, ok, summary line, report lines)],
-    two programs at a time (each runs on one core)."""
+    two programs at a time (each runs on one core), niced when `nice`."""
     with ThreadPoolExecutor(max_workers=2) as pool:
-        return list(pool.map(run_program, targets))
+        return list(pool.map(lambda name: run_program(name, nice), targets))
 
 
-def run_program(name):
+def run_program(name, nice=False):
     """Run one sanitizer-built test program: (program, ok, summary line, report lines)."""
     env = sanitizer_env(leaks=True)
     start = time.monotonic()
+    command = [*(["nice", "-n", "10"] if nice else []), str(SANITIZE_BUILD / "bin" / name)]
     with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
-        done = subprocess.run([str(SANITIZE_BUILD / "bin" / name)], cwd=work, env=env, capture_output=True,
-                              text=True, check=False)
+        done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True, check=False)
     output = done.stdout + done.stderr
     report = grade.sanitizer_report(output, ROOT)
     ok = done.returncode == 0 and not report
@@ -117,10 +144,10 @@ def cmd_sanitize(argv):
 
 
 def start_sanitize(checks):
-    """CI: start the sanitizer build in the background; None if it could not be configured."""
+    """CI: start the sanitizer build and its runs in the background; None if it could not be configured."""
     try:
         with checks.timed("sanitize: configure"):
-            return BackgroundBuild()
+            return BackgroundSuite()
     except CourseError as error:
         checks.record(False, f"sanitizer build: {error}", error.details)
         return None
@@ -128,18 +155,18 @@ def start_sanitize(checks):
 
 def check_sanitize(checks, background):
     """CI: the whole test suite under ASan and UBSan, clean; `background` is the
-    build start_sanitize started."""
+    BackgroundSuite start_sanitize started."""
     try:
-        with checks.timed("sanitize: waiting for its build"):
+        with checks.timed("sanitize: waiting for its build and runs"):
             try:
-                targets = background.finish()
+                results = background.finish()
             finally:
-                checks.add_time("sanitize: build (in the background, niced)", background.seconds or 0.0,
+                checks.add_time("sanitize: build (in the background, niced)", background.build_seconds or 0.0,
+                                concurrent=True)
+                checks.add_time("sanitize: runs (in the background, niced)", background.run_seconds or 0.0,
                                 concurrent=True)
     except BuildFailure as error:
         checks.record(False, f"sanitizer build: {error}", error.lines)
         return
-    with checks.timed("sanitize: runs"):
-        results = run_programs(targets)
     for name, ok, summary, report in results:
         checks.record(ok, f"{name} under ASan+UBSan: {summary}", report)
