@@ -115,6 +115,11 @@ function(add_lab name)
     target_link_libraries(${name}_support PUBLIC common ${LAB_LIBRARIES})
     cl_use_pch(${name}_support ${pch_openmp})
     target_include_directories(${name}_support PUBLIC "${lab_dir}")
+    # The sanitizer build has no precompiled header: a lab's given files in one
+    # batch parse their headers once (lab 05's three: 7.0 s of CPU, not 9.8 s).
+    if(CL_SANITIZE)
+      set_target_properties(${name}_support PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 0)
+    endif()
   else()
     add_library(${name}_support INTERFACE)
     target_include_directories(${name}_support INTERFACE "${lab_dir}")
