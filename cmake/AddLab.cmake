@@ -58,23 +58,10 @@ function(add_lab name)
   list(SORT closure ORDER DESCENDING)
   set_property(GLOBAL PROPERTY CL_LAB_CLOSURE_${name} ${closure})
 
-  # OpenMP flags reach a target through the support libraries it links: this
-  # lab's own (pch_openmp) or, for the driver and the tests, any earlier lab's
-  # too (closure_openmp). The precompiled header must match (cl_use_pch).
-  set(pch_openmp "")
-  if("OpenMP::OpenMP_CXX" IN_LIST LAB_LIBRARIES)
-    set(pch_openmp OPENMP)
-  endif()
-  set(closure_openmp ${pch_openmp})
   set(closure_support ${name}_support)
   foreach(dep IN LISTS closure)
-    get_property(dep_openmp GLOBAL PROPERTY CL_LAB_OPENMP_${dep})
-    if(dep_openmp)
-      set(closure_openmp OPENMP)
-    endif()
     list(APPEND closure_support ${dep}_support)
   endforeach()
-  set_property(GLOBAL PROPERTY CL_LAB_OPENMP_${name} "${pch_openmp}")
 
   # A reference exists when all of the student files are in solutions/NAME; some
   # but not all is a broken tree, not a release.
@@ -113,10 +100,10 @@ function(add_lab name)
     list(TRANSFORM LAB_SUPPORT PREPEND "${lab_dir}/")
     add_library(${name}_support STATIC ${LAB_SUPPORT})
     target_link_libraries(${name}_support PUBLIC common ${LAB_LIBRARIES})
-    cl_use_pch(${name}_support ${pch_openmp})
     target_include_directories(${name}_support PUBLIC "${lab_dir}")
-    # The sanitizer build has no precompiled header: a lab's given files in one
-    # batch parse their headers once (lab 05's three: 7.0 s of CPU, not 9.8 s).
+    # In the sanitizer build, which runs in the background, a lab's given files
+    # compile as one batch that parses their headers once (lab 05's three: 7.0 s
+    # of CPU, not 9.8 s); elsewhere file by file, as written.
     if(CL_SANITIZE)
       set_target_properties(${name}_support PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 0)
     endif()
@@ -177,7 +164,6 @@ function(add_lab name)
   # two-line source generated per executable (cl_program_name, common/cli.h).
   add_library(${name}_driver OBJECT "${lab_dir}/main.cpp")
   target_link_libraries(${name}_driver PRIVATE ${closure_support})
-  cl_use_pch(${name}_driver ${closure_openmp})
   target_compile_definitions(${name}_driver PRIVATE ${scene_definition} CL_LAB_NAME="${name}"
                              CL_PROGRAM_NAME=cl_program_name CL_STUDENT_EARLIER_LABS=cl_student_earlier_labs)
   list(SORT student_earlier)
@@ -193,7 +179,6 @@ function(add_lab name)
   add_library(${name}_test_objects OBJECT ${test_sources})
   target_link_libraries(${name}_test_objects PRIVATE Catch2::Catch2 ${closure_support})
   target_compile_definitions(${name}_test_objects PRIVATE ${scene_definition})
-  cl_use_pch(${name}_test_objects TESTS ${closure_openmp})
   cl_unity_tests(${name}_test_objects)
   cl_test_optimisation(${name}_test_objects)
   add_executable(${name}_tests $<TARGET_OBJECTS:${name}_test_objects>)
@@ -204,6 +189,9 @@ function(add_lab name)
   # lab's student code compiled with AddressSanitizer and UBSan; everything
   # else links as in NAME_tests, uninstrumented, so only a few files compile.
   add_executable(${name}_tests_asan EXCLUDE_FROM_ALL ${test_sources} ${student_sources})
+  # The tests in batches as in NAME_tests; the student's files as written.
+  cl_unity_tests(${name}_tests_asan)
+  set_source_files_properties(${student_sources} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
   target_link_libraries(${name}_tests_asan PRIVATE catch_main ${name}_support)
   list(LENGTH isolated_chain chain_length)
   if(chain_length GREATER 2)
@@ -221,8 +209,7 @@ function(add_lab name)
     add_library(${name}_info_objects OBJECT ${info_sources})
     target_link_libraries(${name}_info_objects PRIVATE ${closure_support})
     target_compile_definitions(${name}_info_objects PRIVATE ${scene_definition})
-    cl_use_pch(${name}_info_objects TESTS ${closure_openmp})
-    cl_test_optimisation(${name}_info_objects)  # its precompiled header is the tests'
+    cl_test_optimisation(${name}_info_objects)
     add_executable(${name}_info $<TARGET_OBJECTS:${name}_info_objects>)
     target_link_libraries(${name}_info PRIVATE ${isolated_chain} common)
     set_target_properties(${name}_info PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
