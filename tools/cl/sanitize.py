@@ -36,10 +36,9 @@ def run_sanitized(log=sys.stdout):
 def configure_sanitized(log=sys.stdout):
     """Configure the sanitizer build (when new or its flags changed); return its test programs' names."""
     configure(log=log)  # labs.json says which labs have a reference
-    # -Og: GCC's level
-    # for debugging, which keeps every line and compiles a third faster than
-    # -O1 under the sanitizers (a lab 06 test batch: 16.6 s of CPU against
-    # 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
+    # -Og: GCC's level for debugging, which keeps every line and compiles a
+    # third faster than -O1 under the sanitizers (a lab 06 test batch: 16.6 s
+    # of CPU against 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
     cache = SANITIZE_BUILD / "CMakeCache.txt"
     if not cache.is_file() or f"CMAKE_CXX_FLAGS_RELWITHDEBINFO:STRING={SANITIZE_FLAGS}" not in cache.read_text():
         quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), *generator_args(SANITIZE_BUILD),
