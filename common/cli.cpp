@@ -1,5 +1,7 @@
 #include "common/cli.h"
 
+#include <algorithm>
+#include <climits>
 #include <cmath>
 #include <iostream>
 #include <sstream>
@@ -47,6 +49,36 @@ CLI::Validator finite_in(double low, double high) {
       "NUMBER");
 }
 
+namespace {
+// A whole argument read as an integer in [low, high]; `name` is what --help shows.
+CLI::Validator integer_check(long long low, long long high, const std::string& name) {
+  return CLI::Validator(
+      [low, high](std::string& text) -> std::string {
+        const std::string range = "[" + std::to_string(low) + ", " + std::to_string(high) + "]";
+        long long value = 0;
+        std::size_t used = 0;
+        try {
+          value = std::stoll(text, &used);
+        } catch (const std::invalid_argument&) {
+          used = 0;
+        } catch (const std::out_of_range&) {
+          return text + " is not in " + range;
+        }
+        if (used == 0 || used != text.size()) return "'" + text + "' is not an integer";
+        if (value < low || value > high) return text + " is not in " + range;
+        return {};
+      },
+      name);
+}
+
+// Any integer the option's type holds; no text in --help (the type says INT).
+CLI::Validator any_integer(long long low, long long high) { return integer_check(low, high, ""); }
+}  // namespace
+
+CLI::Validator integer_in(long long low, long long high) {
+  return integer_check(low, high, "[" + std::to_string(low) + ", " + std::to_string(high) + "]");
+}
+
 CommonOptions lab_defaults(std::string scene, std::string method, std::vector<std::string> methods) {
   CommonOptions options;
   options.scene = std::move(scene);
@@ -67,7 +99,7 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
   }
   if (flags & kFlagIterations) {
     app.add_option("--iterations", options.iterations, "solver iterations per step (0 allowed)")
-        ->check(CLI::Range(0, 100'000'000))
+        ->check(integer_in(0, 100'000'000))
         ->capture_default_str();
   }
   if (flags & kFlagDt) {
@@ -75,7 +107,7 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
   }
   if (flags & kFlagSteps) {
     app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")
-        ->check(CLI::Range(0, 100'000'000));
+        ->check(integer_in(0, 100'000'000));
   }
   if (flags & kFlagOut) app.add_option("--out", options.out, "directory for the CSV files");
   if (flags & kFlagSummary) app.add_option("--summary", options.summary, "write the run summary (JSON) here");
@@ -84,12 +116,12 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
                    options.frames_are_sweeps
                        ? "keep every N-th sweep in OUT/trajectory.json and .bin (./course view OUT)"
                        : "keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT)")
-        ->check(CLI::Range(1, 100'000'000));
+        ->check(integer_in(1, 100'000'000));
   }
 }
 
 Option& Option::range(long long low, long long high) {
-  option_->check(CLI::Range(low, high));
+  option_->check(integer_in(low, high));
   return *this;
 }
 
@@ -133,55 +165,76 @@ Option& Option::excludes(const Option& other) {
   return *this;
 }
 
+Option& Option::only_for_methods(std::vector<std::string> methods) {
+  if (line_ == nullptr) throw std::logic_error("Option::only_for_methods: an option of a CommandLine only");
+  line_->method_flags_.push_back({option_, std::move(methods)});
+  return *this;
+}
+
 CommandLine::CommandLine(const std::string& description, const std::string& program_name)
     : app_(std::make_unique<CLI::App>(description, program_name)) {}
 
 CommandLine::~CommandLine() = default;
 
 Option CommandLine::add_option(const std::string& name, std::string& value, const std::string& help) {
-  return Option(app_->add_option(name, value, help));
+  return Option(app_->add_option(name, value, help), this);
 }
 
+// Integers are checked as text before CLI11 converts them, so that "abc"
+// reads "'abc' is not an integer" rather than CLI11's "Value abc not in range".
 Option CommandLine::add_option(const std::string& name, int& value, const std::string& help) {
-  return Option(app_->add_option(name, value, help));
+  return Option(app_->add_option(name, value, help)->check(any_integer(INT_MIN, INT_MAX)), this);
 }
 
 Option CommandLine::add_option(const std::string& name, long long& value, const std::string& help) {
-  return Option(app_->add_option(name, value, help));
+  return Option(app_->add_option(name, value, help)->check(any_integer(LLONG_MIN, LLONG_MAX)), this);
 }
 
 Option CommandLine::add_option(const std::string& name, double& value, const std::string& help) {
-  return Option(app_->add_option(name, value, help));
+  return Option(app_->add_option(name, value, help), this);
 }
 
 Option CommandLine::add_option(const std::string& name, std::optional<double>& value, const std::string& help) {
-  return Option(app_->add_option(name, value, help));
+  return Option(app_->add_option(name, value, help), this);
 }
 
 Option CommandLine::add_option(const std::string& name, std::vector<int>& values, const std::string& help) {
-  return Option(app_->add_option(name, values, help));
+  return Option(app_->add_option(name, values, help)->check(any_integer(INT_MIN, INT_MAX)), this);
 }
 
 Option CommandLine::add_option(const std::string& name, std::vector<double>& values, const std::string& help) {
-  return Option(app_->add_option(name, values, help));
+  return Option(app_->add_option(name, values, help), this);
 }
 
 Option CommandLine::add_option(const std::string& name, std::vector<std::string>& values, const std::string& help) {
-  return Option(app_->add_option(name, values, help));
+  return Option(app_->add_option(name, values, help), this);
 }
 
 Option CommandLine::add_flag(const std::string& name, bool& value, const std::string& help) {
-  return Option(app_->add_flag(name, value, help));
+  return Option(app_->add_flag(name, value, help), this);
 }
 
-Option CommandLine::get_option(const std::string& name) { return Option(app_->get_option(name)); }
+Option CommandLine::get_option(const std::string& name) { return Option(app_->get_option(name), this); }
+
+void CommandLine::refuse_unused_flags() const {
+  for (const MethodFlag& flag : method_flags_) {
+    if (flag.option->count() == 0) continue;
+    if (method_ == nullptr) throw std::logic_error(flag.option->get_name() + ": only_for_methods needs --method");
+    if (std::find(flag.methods.begin(), flag.methods.end(), *method_) != flag.methods.end()) continue;
+    std::string users;
+    for (const std::string& method : flag.methods) users += (users.empty() ? "" : ", ") + method;
+    throw InputError(flag.option->get_name() + ": --method " + *method_ + " does not use it (only " + users +
+                     (flag.methods.size() == 1 ? " does)" : " do)"));
+  }
+}
 
 void add_common_options(CommandLine& line, CommonOptions& options, unsigned flags) {
   add_common_options(line.app(), options, flags);
+  if (flags & kFlagMethod) line.method_ = &options.method;
 }
 
-Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir) {
-  Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir));
+Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir, const std::string& flag) {
+  Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir, flag));
   if (options.dt > 0.0) scene.dt = options.dt;
   if (options.steps >= 0) scene.steps = options.steps;
   if (options.frames > 0) {
@@ -250,7 +303,11 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
 
 int run_main(CommandLine& line, int argc, char** argv, const std::function<int()>& body,
              const char* student_earlier_labs) {
-  return run_main(line.app(), argc, argv, body, student_earlier_labs);
+  // The unused flags are refused before the body runs: nothing is written.
+  return run_main(line.app(), argc, argv, [&] {
+    line.refuse_unused_flags();
+    return body();
+  }, student_earlier_labs);
 }
 
 }  // namespace cl

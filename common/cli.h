@@ -73,6 +73,11 @@ CLI::Validator finite_number(bool allow_zero);
 // A CLI11 check: a finite number in [low, high] (CLI::Range lets "nan" through).
 CLI::Validator finite_in(double low, double high);
 
+// A CLI11 check: the whole argument an integer in [low, high]; its message is
+// one short line, "'abc' is not an integer" or "0 is not in [1, 16]" (CLI11's
+// Range says "Value abc not in range" for both).
+CLI::Validator integer_in(long long low, long long high);
+
 // Registers the flags in `flags` on `app`. Set the defaults in `options`
 // (scene, method, methods, iterations) before calling.
 void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
@@ -80,16 +85,20 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 // Loads the scene named by --scene for a lab whose scenes live in
 // lab_scene_dir, and applies --dt and --steps. With --frames N it also refuses
 // a run without --out and one whose trajectory would be over the size cap
-// (check_trajectory_size), before anything is written. Throws InputError.
-Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir);
+// (check_trajectory_size), before anything is written. Throws InputError; an
+// unknown name is blamed on `flag` (--sweep-scenes, for a sweep's scenes).
+Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir,
+                     const std::string& flag = "--scene");
 
 
 // One option of a CommandLine, for chaining its checks and help, in CLI11's
 // terms: app.add_option("--seed", seed, "...").range(0, 1000).capture_default_str().
+class CommandLine;
+
 class Option {
  public:
-  explicit Option(CLI::Option* option) : option_(option) {}
-  Option& range(long long low, long long high);                // an integer in [low, high] (CLI::Range)
+  explicit Option(CLI::Option* option, CommandLine* line = nullptr) : option_(option), line_(line) {}
+  Option& range(long long low, long long high);                // an integer in [low, high] (integer_in)
   Option& one_of(const std::vector<std::string>& words);       // one of these words (CLI::IsMember)
   Option& positive();                                          // finite_number(false): finite, > 0
   Option& non_negative();                                      // finite_number(true): finite, >= 0
@@ -98,9 +107,14 @@ class Option {
   Option& capture_default_str();                               // --help shows the default
   Option& description(const std::string& text);
   Option& excludes(const Option& other);                       // not together with `other`
+  // Only these --method choices read the option: given with another, it is
+  // refused before the run (exit 2, one line: "--rho: --method pd does not
+  // use it (only pd-chebyshev, jacobi-chebyshev do)"), not silently ignored.
+  Option& only_for_methods(std::vector<std::string> methods);
 
  private:
   CLI::Option* option_;
+  CommandLine* line_;
 };
 
 // A lab's command line: a CLI::App behind an interface that takes the option
@@ -125,15 +139,31 @@ class CommandLine {
 
   CLI::App& app() { return *app_; }
 
+  // Throws InputError for the first option given with a --method that its
+  // only_for_methods list leaves out; run_main calls it after parsing.
+  void refuse_unused_flags() const;
+
  private:
+  friend class Option;
+  friend void add_common_options(CommandLine& line, CommonOptions& options, unsigned flags);
+  struct MethodFlag {
+    CLI::Option* option;
+    std::vector<std::string> methods;
+  };
   std::unique_ptr<CLI::App> app_;
+  std::vector<MethodFlag> method_flags_;
+  const std::string* method_ = nullptr;  // the --method value (add_common_options with kFlagMethod)
 };
 
+// With kFlagMethod it also tells `line` where --method's choice lands, for
+// Option::only_for_methods.
 void add_common_options(CommandLine& line, CommonOptions& options, unsigned flags);
 
 // Parses the command line and runs `body`, mapping every failure to a single
 // stderr line and exit code: CLI and InputError -> 2, NotImplemented -> 3,
 // anything else -> 1. `body` returns the exit code for a run that finished.
+// With a CommandLine, the options given to a method that does not use them are
+// refused first (refuse_unused_flags), before `body` writes anything.
 // A run that gets past its input (exit 0, 1 or 3) and links the student's code
 // of earlier labs (`student_earlier_labs`) says so in one more stderr line; a
 // refusal (exit 2) stays one line.

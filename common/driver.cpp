@@ -27,7 +27,7 @@ std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<s
   for (const std::string& name : names.empty() ? std::vector<std::string>{options.scene} : names) {
     CommonOptions one = options;
     one.scene = name;
-    scenes.push_back(load_scene_for(one, lab_scene_dir));
+    scenes.push_back(load_scene_for(one, lab_scene_dir, names.empty() ? "--scene" : "--sweep-scenes"));
   }
   return scenes;
 }

@@ -21,7 +21,8 @@ namespace cl {
 
 // The scenes a sweep runs: each name of `names` (--sweep-scenes) or, when it
 // is empty, --scene alone, loaded as load_scene_for does (--dt and --steps
-// applied). Throws InputError for the first that does not load.
+// applied). Throws InputError for the first that does not load (an unknown
+// name of `names` blamed on --sweep-scenes).
 std::vector<Scene> load_scenes(const CommonOptions& options, const std::vector<std::string>& names,
                                const std::string& lab_scene_dir);
 

@@ -563,7 +563,8 @@ Scene load_scene(const std::string& path) {
   return parse_scene(text.str(), path);
 }
 
-std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir) {
+std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir,
+                               const std::string& flag) {
   std::error_code error;
   const bool looks_like_path = name_or_path.find('/') != std::string::npos ||
                                (name_or_path.size() > 5 && name_or_path.substr(name_or_path.size() - 5) == ".json");
@@ -581,9 +582,27 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
     const fs::path candidate = place / (name_or_path + ".json");
     if (fs::is_regular_file(candidate, error)) return candidate.string();
   }
+  // What this lab can load: its own scenes, and every other lab's by name
+  // (names are unique across labs). A lab without scenes of its own (11, 12
+  // run lab 06's and lab 04's) lists all of them, grouped by lab.
+  auto joined = [](const std::vector<std::string>& names) {
+    std::string text;
+    for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+    return text;
+  };
+  const std::vector<std::string> own = list_scene_names(lab_scene_dir);
   std::string known;
-  for (const std::string& name : list_scene_names(lab_scene_dir)) known += (known.empty() ? "" : ", ") + name;
-  throw InputError("--scene: no scene named '" + name_or_path + "' (this lab ships: " + known + ")");
+  if (!own.empty()) {
+    known = "this lab ships: " + joined(own) + "; any other lab's scene loads by its name too";
+  } else {
+    known = "this lab ships none; it loads any lab's scene by name:";
+    for (std::size_t p = 1; p < places.size(); ++p) {
+      const std::vector<std::string> names = list_scene_names(places[p].string());
+      if (!names.empty()) known += " " + places[p].parent_path().filename().string() + ": " + joined(names) + ";";
+    }
+    known.pop_back();
+  }
+  throw InputError(flag + ": no scene named '" + name_or_path + "' (" + known + ")");
 }
 
 std::string lab_scene_dir(const std::string& lab) {

@@ -41,8 +41,11 @@ Scene load_scene(const std::string& path);
 
 // Resolves --scene: an argument that names an existing file or ends in .json is
 // a path; otherwise it is a scene name looked up as NAME.json in lab_scene_dir,
-// then in every lab's scenes/. Throws InputError naming the places searched.
-std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir);
+// then in every lab's scenes/. Throws InputError for an unknown name, blaming
+// `flag` (the option that gave it) and listing what the lab can load: its own
+// scenes, or, for a lab without any (labs 11 and 12), every lab's by lab.
+std::string resolve_scene_path(const std::string& name_or_path, const std::string& lab_scene_dir,
+                               const std::string& flag = "--scene");
 
 // Every scene name shipped in a scenes directory, sorted.
 std::vector<std::string> list_scene_names(const std::string& scene_dir);

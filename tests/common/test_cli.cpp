@@ -1,6 +1,9 @@
 // The shared command line: scene lookup and the exit-code mapping of run_main.
 #include <filesystem>
+#include <iostream>
 #include <map>
+#include <sstream>
+#include <utility>
 
 #include <CLI/CLI.hpp>
 #include <catch2/catch.hpp>
@@ -48,6 +51,72 @@ TEST_CASE("scene names resolve to shipped files, paths stay paths", "[common][cl
     CHECK_THAT(std::string(error.what()), Contains("no scene named 'no-such-scene'"));
     CHECK_THAT(std::string(error.what()), Contains("two-particles"));
   }
+}
+
+TEST_CASE("an unknown scene name lists what the lab can load", "[common][cli]") {
+  // A lab with scenes of its own lists them; one without (lab 11 runs lab 06's
+  // and lab 04's) lists every lab's, by lab, never an empty list.
+  CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", kLab01Scenes),
+                    Contains("this lab ships: ") && Contains("two-particles"));
+  CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", cl::lab_scene_dir("lab11_acceleration")),
+                    Contains("lab06_projective_dynamics: ") && Contains("pd-curtain-32") &&
+                        Contains("lab04_pbd: ") && !Contains("ships: )"));
+  CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", kLab01Scenes, "--sweep-scenes"),
+                    Catch::Matchers::StartsWith("--sweep-scenes: no scene named 'nosuch'"));
+}
+
+TEST_CASE("integer flags say the text is not an integer or which range it is outside", "[common][cli]") {
+  const CLI::Validator check = cl::integer_in(1, 16);
+  for (std::string good : {"1", "16", "7"}) {
+    CAPTURE(good);
+    CHECK(check(good).empty());
+  }
+  std::string text = "abc";
+  CHECK(check(text) == "'abc' is not an integer");
+  text = "1.5";
+  CHECK(check(text) == "'1.5' is not an integer");
+  text = "";
+  CHECK(check(text) == "'' is not an integer");
+  text = "17";
+  CHECK(check(text) == "17 is not in [1, 16]");
+  text = "99999999999999999999";
+  CHECK(check(text) == "99999999999999999999 is not in [1, 16]");
+}
+
+namespace {
+// Runs a CommandLine with --method (pd, pd-chebyshev) and --rho (pd-chebyshev
+// only), --iterations and an int --seed without a range; the exit code and stderr.
+std::pair<int, std::string> run_line(std::vector<std::string> arguments) {
+  cl::CommandLine line{"test", "probe"};
+  cl::CommonOptions options = cl::lab_defaults("two-particles", "pd", {"pd", "pd-chebyshev"});
+  cl::add_common_options(line, options, cl::kFlagMethod | cl::kFlagIterations);
+  double rho = 0.0;
+  int seed = 0;
+  line.add_option("--rho", rho, "rho").non_negative().only_for_methods({"pd-chebyshev"});
+  line.add_option("--seed", seed, "seed");
+  arguments.insert(arguments.begin(), "probe");
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  std::ostringstream captured;
+  std::streambuf* const saved = std::cerr.rdbuf(captured.rdbuf());
+  const int code = cl::run_main(line, static_cast<int>(argv.size()), argv.data(), [] { return 0; });
+  std::cerr.rdbuf(saved);
+  return {code, captured.str()};
+}
+}  // namespace
+
+TEST_CASE("a flag the chosen method does not use is refused in one line", "[common][cli]") {
+  CHECK(run_line({"--method", "pd-chebyshev", "--rho", "0.5"}).first == 0);
+  CHECK(run_line({"--method", "pd"}).first == 0);
+  const auto [code, text] = run_line({"--method", "pd", "--rho", "0.5"});
+  CHECK(code == 2);
+  CHECK(text == "probe: --rho: --method pd does not use it (only pd-chebyshev does)\n");
+  // The default method counts as chosen.
+  CHECK(run_line({"--rho", "0.5"}).first == 2);
+  // Integer flags, with a range and without one.
+  CHECK(run_line({"--iterations", "abc"}).second == "probe: --iterations: 'abc' is not an integer (see --help)\n");
+  CHECK(run_line({"--seed", "1x"}).second == "probe: --seed: '1x' is not an integer (see --help)\n");
+  CHECK(run_line({"--seed", "12"}).first == 0);
 }
 
 TEST_CASE("run_main maps each outcome to its exit code", "[common][cli]") {

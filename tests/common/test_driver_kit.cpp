@@ -42,6 +42,11 @@ TEST_CASE("load_scenes loads the sweep's scenes in order, or --scene alone, with
   CHECK(both[1].steps == 3);
 
   CHECK_THROWS_AS(cl::load_scenes(options, {"driver_kit_no_such_scene.json"}, "."), cl::InputError);
+  // An unknown name is the fault of the flag that gave it.
+  CHECK_THROWS_WITH(cl::load_scenes(options, {"driver-kit-no-such-name"}, "."),
+                    Catch::Matchers::StartsWith("--sweep-scenes: no scene named 'driver-kit-no-such-name'"));
+  options.scene = "driver-kit-no-such-name";
+  CHECK_THROWS_WITH(cl::load_scenes(options, {}, "."), Catch::Matchers::StartsWith("--scene: no scene named"));
 }
 
 TEST_CASE("costliest_first orders by cost, ties in their order", "[common][driver]") {
