@@ -237,7 +237,7 @@ StepReport Solver::projective_dynamics(Eigen::Matrix3Xd& x, const Eigen::Matrix3
   auto record = [&](int iteration, double value) {
     if (!on_iteration) return false;
     const Timer timer;
-    const bool stop = on_iteration({iteration, value, clock.seconds() - excluded, factorizations_});
+    const bool stop = on_iteration({iteration, value, clock.seconds() - excluded, factorizations_, &x});
     excluded += timer.seconds();
     return stop;
   };
@@ -278,7 +278,7 @@ StepReport Solver::newton(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
   auto record = [&](int iteration, double value) {
     if (!on_iteration) return false;
     const Timer timer;
-    const bool stop = on_iteration({iteration, value, clock.seconds() - excluded, factorizations_});
+    const bool stop = on_iteration({iteration, value, clock.seconds() - excluded, factorizations_, &x});
     excluded += timer.seconds();
     return stop;
   };

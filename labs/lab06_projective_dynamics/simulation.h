@@ -41,6 +41,8 @@ struct IterationRecord {
   double seconds = 0.0;    // wall time of the method's own work since the step began
                            // (not the objective evaluations made only for this record)
   int factorizations = 0;  // the solver's count so far
+  const Eigen::Matrix3Xd* x = nullptr;  // the iterate (valid during the callback only; lab 13
+                                        // measures its distance to the step)
 };
 // Returns true to end the step at this iterate (the experiment stops a run
 // once it is close enough to the minimum).

@@ -10,16 +10,13 @@
 
 namespace cl::lab09 {
 
-namespace {
-
-lab07::StepSolution solve(const lab07::LinearizedStep& step, const SparseMatrix& stiffness, lab07::Method method) {
+lab07::StepSolution solve_stiff(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
+                                lab07::Method method) {
   if (method == lab07::Method::kKkt) {
     return lab07::solve_kkt(stiff_kkt_system(step, stiffness), step.velocity.size());
   }
   return solve_stiff_schur(step, stiffness);
 }
-
-}  // namespace
 
 StableStepResult stable_step(Particles& particles, const std::vector<Spring>& springs, const MovableMap& map,
                              const StableSettings& settings, const Eigen::VectorXd& previous_lambda) {
@@ -30,7 +27,7 @@ StableStepResult stable_step(Particles& particles, const std::vector<Spring>& sp
   if (settings.geometric_stiffness && !springs.empty()) {
     Eigen::VectorXd lambda_bar = previous_lambda;
     if (lambda_bar.size() != static_cast<Eigen::Index>(springs.size())) {
-      const lab07::StepSolution first = solve(step, stiffness, settings.step.method);
+      const lab07::StepSolution first = solve_stiff(step, stiffness, settings.step.method);
       result.problem = lab07::solution_problem(first, size, step.phi.size());
       if (!result.problem.empty()) return result;
       lambda_bar = first.lambda;
@@ -38,7 +35,7 @@ StableStepResult stable_step(Particles& particles, const std::vector<Spring>& sp
     }
     stiffness = geometric_stiffness(particles.x, springs, lambda_bar, map, settings.compression);
   }
-  lab07::StepSolution solution = solve(step, stiffness, settings.step.method);
+  lab07::StepSolution solution = solve_stiff(step, stiffness, settings.step.method);
   result.problem = lab07::solution_problem(solution, size, step.phi.size());
   if (!result.problem.empty()) return result;
   lab07::update_positions(particles, map, solution.velocity, settings.step.dt);

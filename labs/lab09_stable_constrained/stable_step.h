@@ -30,6 +30,12 @@ struct StableStepResult {
   bool first_solve = false;  // K_g's λ̄ came from a first solve without K_g (no previous λ)
 };
 
+// The system with K_g = stiffness solved by `method`: stiff_kkt_system and
+// lab07::solve_kkt (Method::kKkt), or solve_stiff_schur (Method::kSchur).
+// Lab 13 solves each of its Newton iterations with it.
+lab07::StepSolution solve_stiff(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
+                                lab07::Method method);
+
 // One step of size settings.step.dt. K_g is built from λ̄ = previous_lambda,
 // the multipliers of the previous step (pass the last result's lambda). When
 // previous_lambda does not have one entry per spring (the first step), λ̄ comes

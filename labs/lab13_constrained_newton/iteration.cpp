@@ -1,0 +1,258 @@
+// Lab 13 — given code: the constrained Newton iteration, its safeguard, the run.
+#include "iteration.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include "../lab06_projective_dynamics/simulation.h"
+#include "common/health.h"
+#include "common/metrics.h"
+#include "common/timer.h"
+#include "stable_step.h"
+
+namespace cl::lab13 {
+
+namespace {
+
+void check(const Settings& settings) {
+  if (settings.iterations < 0) throw std::invalid_argument("iterations must be >= 0");
+  if (!std::isfinite(settings.tolerance) || settings.tolerance < 0.0) {
+    throw std::invalid_argument("tolerance must be finite and >= 0");
+  }
+  if (settings.max_backtracks < 0) throw std::invalid_argument("max_backtracks must be >= 0");
+  if (!settings.gravity.allFinite()) throw std::invalid_argument("gravity must be finite");
+}
+
+}  // namespace
+
+const char* start_name(Start start) { return start == Start::kPrediction ? "prediction" : "x"; }
+
+Start start_from_name(const std::string& name) {
+  if (name == "x") return Start::kPositions;
+  if (name == "prediction") return Start::kPrediction;
+  throw std::invalid_argument("unknown start '" + name + "' (x or prediction)");
+}
+
+const char* warm_name(Warm warm) { return warm == Warm::kZero ? "zero" : "forces"; }
+
+Warm warm_from_name(const std::string& name) {
+  if (name == "forces") return Warm::kForces;
+  if (name == "zero") return Warm::kZero;
+  throw std::invalid_argument("unknown warm start '" + name + "' (forces or zero)");
+}
+
+double length_scale(const std::vector<Spring>& springs) {
+  double sum = 0.0;
+  for (const Spring& s : springs) sum += s.rest_length;
+  return sum > 0.0 ? sum / static_cast<double>(springs.size()) : 1.0;
+}
+
+Solver::Solver(const Eigen::VectorXd& inv_mass, const std::vector<Spring>& springs, double dt)
+    : inv_mass_(inv_mass), map_(make_movable_map(inv_mass)), dt_(dt) {
+  if (!std::isfinite(dt) || !(dt > 0.0)) throw std::invalid_argument("dt must be finite and > 0");
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    if (s.i < 0 || s.j < 0 || s.i >= inv_mass.size() || s.j >= inv_mass.size()) {
+      throw std::invalid_argument("springs[" + std::to_string(e) + "] has an index out of range");
+    }
+    if (inv_mass[s.i] > 0.0 || inv_mass[s.j] > 0.0) springs_.push_back(s);
+  }
+  compliance_ = lab07::compliance_of(springs_);
+  weights_ = merit_weights(springs_, inv_mass_, compliance_, dt_);
+  length_scale_ = length_scale(springs_);
+}
+
+bool Solver::all_compliant() const {
+  return springs_.empty() || (compliance_.size() != 0 && (compliance_.array() > 0.0).all());
+}
+
+StepReport Solver::step(Particles& particles, const Settings& settings, const IterationCallback& on_iteration) {
+  check(settings);
+  if (particles.size() != inv_mass_.size() || particles.v.cols() != particles.size()) {
+    throw std::invalid_argument("Solver::step: the particles do not match the solver's scene");
+  }
+  const Timer timer;
+  const Eigen::Matrix3Xd y = lab06::predict(particles, settings.gravity, dt_);
+  Eigen::Matrix3Xd x = settings.start == Start::kPrediction ? y : particles.x;
+  Eigen::VectorXd lambda = warm_start(particles.x, springs_, previous_lambda_, settings.warm);
+  StepReport report = iterate(x, lambda, y, settings, on_iteration);
+  if (report.problem.empty()) {
+    for (Eigen::Index p = 0; p < particles.size(); ++p) {
+      particles.v.col(p) = inv_mass_[p] > 0.0 ? Eigen::Vector3d((x.col(p) - particles.x.col(p)) / dt_)
+                                              : Eigen::Vector3d::Zero();
+    }
+    particles.x = x;
+    previous_lambda_ = std::move(lambda);
+  }
+  report.seconds = timer.seconds();
+  return report;
+}
+
+StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
+                           const Settings& settings, const IterationCallback& on_iteration) const {
+  check(settings);
+  const Eigen::Index n = inv_mass_.size();
+  if (x.cols() != n || y.cols() != n) throw std::invalid_argument("Solver::iterate: x and y need one column per particle");
+  if (lambda.size() != static_cast<Eigen::Index>(springs_.size())) {
+    throw std::invalid_argument("Solver::iterate: lambda needs one entry per spring");
+  }
+  StepReport report;
+  report.linear_solver = all_compliant() ? "schur" : "kkt";
+  const lab07::Method method = all_compliant() ? lab07::Method::kSchur : lab07::Method::kKkt;
+  lab07::StepSettings linear;
+  linear.dt = dt_;
+  linear.gravity = settings.gravity;
+  linear.method = method;
+  const Timer clock;
+  double excluded = 0.0;  // time spent only for the records
+
+  auto evaluate = [&](const Eigen::Matrix3Xd& at, const Eigen::VectorXd& multipliers) {
+    return residuals(at, y, multipliers, springs_, inv_mass_, map_, compliance_, dt_);
+  };
+  Residuals r = evaluate(x, lambda);
+  Convergence c = convergence(r, length_scale_, settings.tolerance);
+  double psi = merit(r, inv_mass_, map_, weights_, dt_);
+  auto record = [&](int iteration, double alpha, int backtracks) {
+    if (!on_iteration) return false;
+    const Timer timer;
+    const bool stop = on_iteration(
+        {iteration, c.force_error, c.constraint_error, psi, alpha, backtracks, clock.seconds() - excluded, &x});
+    excluded += timer.seconds();
+    return stop;
+  };
+  bool stopped = record(0, 0.0, 0);
+  Particles at;  // lab 07's linearisation reads positions and inverse masses from a state
+  at.inv_mass = inv_mass_;
+  at.v.setZero(3, n);
+  for (int k = 1; k <= settings.iterations && !stopped; ++k) {
+    if ((settings.tolerance > 0.0 && c.converged) || psi == 0.0) break;
+    const std::string where = "constrained newton iteration " + std::to_string(k) + ": ";
+    at.x = x;
+    lab07::LinearizedStep step = lab07::linearize(at, springs_, map_, linear);
+    step.velocity = rebased_velocity(x, y, map_, settings.gravity, dt_);
+    SparseMatrix stiffness = lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression);
+    lab07::StepSolution solution = lab09::solve_stiff(step, stiffness, method);
+    if (!solution.ok && settings.compression == lab09::Compression::kKeep) {
+      // The exact matrix is not definite here (compressed springs): the Schur
+      // solve refuses it, lab 07's KKT solve (LU) takes it as it is; only when
+      // that fails too does this iteration drop them, as lab 09's step does.
+      ++report.fallbacks;
+      if (method == lab07::Method::kSchur) solution = lab09::solve_stiff(step, stiffness, lab07::Method::kKkt);
+      if (!solution.ok) {
+        stiffness = lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kDrop);
+        solution = lab09::solve_stiff(step, stiffness, method);
+      }
+    }
+    const std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
+    if (!problem.empty()) {
+      report.problem = where + problem;
+      return report;
+    }
+    const Eigen::VectorXd dx = dt_ * solution.velocity;
+    const Eigen::VectorXd dlambda = solution.lambda - lambda;
+    // The safeguard: halve α until the merit falls enough (sufficient_decrease).
+    double alpha = 1.0;
+    int backtracks = 0;
+    bool accepted = false;
+    Eigen::Matrix3Xd trial;
+    Eigen::VectorXd trial_lambda;
+    Residuals trial_r;
+    double trial_psi = 0.0;
+    while (true) {
+      trial = x;
+      for (int u = 0; u < map_.unknowns(); ++u) {
+        trial.col(map_.particle_of[static_cast<std::size_t>(u)]) += alpha * dx.segment<3>(3 * u);
+      }
+      trial_lambda = lambda + alpha * dlambda;
+      trial_r = evaluate(trial, trial_lambda);
+      trial_psi = merit(trial_r, inv_mass_, map_, weights_, dt_);
+      if (sufficient_decrease(psi, trial_psi, alpha)) {
+        accepted = true;
+        break;
+      }
+      if (backtracks == settings.max_backtracks) break;
+      alpha *= 0.5;
+      ++backtracks;
+    }
+    report.backtracks += backtracks;
+    if (!accepted) {
+      report.failed_decreases = 1;  // x and λ stay at the last accepted iterate
+      break;
+    }
+    x = std::move(trial);
+    lambda = std::move(trial_lambda);
+    r = std::move(trial_r);
+    psi = trial_psi;
+    c = convergence(r, length_scale_, settings.tolerance);
+    report.iterations_done = k;
+    stopped = record(k, alpha, backtracks);
+  }
+  report.converged = (settings.tolerance > 0.0 && c.converged) || psi == 0.0;
+  report.force_error = c.force_error;
+  report.constraint_error = c.constraint_error;
+  report.merit = psi;
+  if (!all_finite(x) || !lambda.allFinite()) report.problem = "constrained newton: non-finite iterate";
+  return report;
+}
+
+// ------------------------------------------------------------------ a run
+
+double total_energy(const Particles& particles, const std::vector<Spring>& springs, const Eigen::Vector3d& gravity) {
+  return kinetic_energy(particles) + potential_energy(particles, gravity) + lab09::spring_energy(particles.x, springs);
+}
+
+RunResult run_steps(Particles& particles, Solver& solver, const Settings& settings, int steps,
+                    const RunIterationCallback& on_iteration, const FrameOutput& output,
+                    const RunStepCallback& on_step) {
+  if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0");
+  const std::vector<Spring>& springs = solver.springs();
+  RunResult result;
+  StepReport report;
+  auto step = [&](int s) {
+    IterationCallback each = nullptr;
+    if (on_iteration) {
+      each = [&](const IterationRecord& iteration) {
+        on_iteration(s, iteration);
+        return false;
+      };
+    }
+    report = solver.step(particles, settings, each);
+    result.iterations_done += report.iterations_done;
+    result.backtracks += report.backtracks;
+    result.failed_decreases += report.failed_decreases;
+    result.fallbacks += report.fallbacks;
+    if (report.problem.empty() && !report.converged && settings.tolerance > 0.0) ++result.unconverged_steps;
+    if (report.problem.empty() && on_step) on_step(s, report);
+    return StepVerdict{report.problem, report.problem.empty(), report.seconds};
+  };
+  auto measured = [&](int s, double) {
+    const StepReport done = s > 0 ? report : StepReport{};
+    const StrainStats strain = strain_stats(particles.x, springs);
+    const double energy = total_energy(particles, springs, settings.gravity);
+    return FrameMeasure{strain, energy, {},
+                        {static_cast<long long>(done.iterations_done), static_cast<long long>(done.converged ? 1 : 0),
+                         static_cast<long long>(done.backtracks), static_cast<long long>(done.failed_decreases),
+                         static_cast<long long>(done.fallbacks),
+                         done.force_error, done.constraint_error, done.merit, done.seconds, strain.max, strain.rms,
+                         energy},
+                        {}};
+  };
+  const double scale = energy_scale(particles, settings.gravity, solver.dt()) +
+                       lab09::spring_energy(particles.x, springs);
+  FrameOutput with_index = output;
+  with_index.index_column = "step";
+  const FrameLoopResult run =
+      run_frame_loop(particles, step, measured, frame_plan(steps, solver.dt(), scale), with_index);
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.energy_start = run.energy_start;
+  result.energy_end = run.energy_end;
+  return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"iterations", "converged",        "backtracks", "failed_decreases", "fallbacks",  "force_error",
+          "constraint_error", "merit", "seconds",    "max_strain",       "rms_strain", "total_energy"};
+}
+
+}  // namespace cl::lab13
