@@ -171,9 +171,9 @@ int main(int argc, char** argv) {
       .non_negative().capture_default_str();
   app.add_option("--threads", lab.threads, "OpenMP threads for the sweep").range(1, 1024).capture_default_str();
   app.add_option("--rho", rho, "vbd-chebyshev: the spectral radius, in [0, 1) (default: estimated per scene)")
-      .non_negative();
+      .non_negative().only_for_methods({"vbd-chebyshev"});
   app.add_option("--estimate-iterations", lab.estimate_iterations, "plain sweeps that estimate rho (no --rho)")
-      .range(2, 1'000'000).capture_default_str();
+      .range(2, 1'000'000).capture_default_str().only_for_methods({"vbd-chebyshev"});
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   return cl::run_main(app, argc, argv, [&] {
