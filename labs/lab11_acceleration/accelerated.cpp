@@ -372,6 +372,7 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
       history.clear();
       direction = -initial(gradient);
       slope = gradient.dot(direction);
+      if (slope < 0.0) ++report.descent_fallbacks;  // PD's direction descends where the recursion's did not
     }
     if (!(slope < 0.0)) {  // ∇g = 0 to the last bit
       report.converged = true;
@@ -540,6 +541,7 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
     result.iterations_done += report.iterations_done;
     result.restarts += report.restarts;
     result.failed_line_searches += report.failed_line_searches;
+    result.descent_fallbacks += report.descent_fallbacks;
     return StepVerdict{report.problem, true, report.seconds};
   };
   auto measured = [&](int s, double) {
@@ -552,7 +554,8 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
                         {record.report.objective, static_cast<long long>(record.report.iterations_done),
                          static_cast<long long>(record.report.converged ? 1 : 0),
                          static_cast<long long>(record.report.restarts),
-                         static_cast<long long>(record.report.failed_line_searches), record.report.seconds,
+                         static_cast<long long>(record.report.failed_line_searches),
+                         static_cast<long long>(record.report.descent_fallbacks), record.report.seconds,
                          record.strain.max, record.strain.rms, record.total_energy},
                         {}};
   };
@@ -569,8 +572,8 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
 }
 
 std::vector<std::string> step_columns() {
-  return {"objective", "iterations", "converged", "restarts", "failed_line_searches", "seconds", "max_strain",
-          "rms_strain", "total_energy"};
+  return {"objective", "iterations", "converged", "restarts", "failed_line_searches", "descent_fallbacks", "seconds",
+          "max_strain", "rms_strain", "total_energy"};
 }
 
 }  // namespace cl::lab11

@@ -58,6 +58,12 @@ struct StepReport {
   double objective = 0.0;        // as in IterationRecord, at the result
   int restarts = 0;              // Chebyshev
   int failed_line_searches = 0;  // L-BFGS and Newton: no decrease found (the step stops there)
+  // L-BFGS: iterations whose two-loop direction was not a descent (∇gᵀd >= 0
+  // or not finite), replaced by PD's −A⁻¹∇g with the history forgotten. A
+  // correct lbfgs_direction never needs one on a well-posed scene (its H stays
+  // positive definite); a wrong one needs them all the time and then runs as
+  // plain PD, which converges anyway: this count is where it shows.
+  int descent_fallbacks = 0;
   bool converged = false;        // stopped by the tolerance, or at round-off
   double seconds = 0.0;
   std::string problem;           // non-empty: the step failed; the particles are unchanged
@@ -193,6 +199,7 @@ struct RunResult {
   long long iterations_done = 0;
   int restarts = 0;
   int failed_line_searches = 0;
+  int descent_fallbacks = 0;
   double seconds = 0.0;
   double energy_start = 0.0, energy_end = 0.0;
   std::string problem;    // empty unless the run stopped unhealthy
@@ -208,8 +215,8 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
                     const StepCallback& on_step = nullptr, const RunIterationCallback& on_iteration = nullptr,
                     const FrameOutput& output = {});
 
-// objective, iterations, converged, restarts, failed_line_searches, seconds,
-// max_strain, rms_strain, total_energy.
+// objective, iterations, converged, restarts, failed_line_searches,
+// descent_fallbacks, seconds, max_strain, rms_strain, total_energy.
 std::vector<std::string> step_columns();
 
 }  // namespace cl::lab11

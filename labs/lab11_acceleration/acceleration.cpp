@@ -4,7 +4,7 @@
 // The five functions below are the pieces of the accelerated loops; the given
 // code (accelerated.cpp) runs them. Besides the tests named in each block,
 // the Chebyshev-bound case of tests/lab11_acceleration/test_update.cpp (2 pts)
-// needs lab11.1 and lab11.2, and test_loops.cpp (8 pts) runs whole
+// needs lab11.1 and lab11.2, and test_loops.cpp (9 pts) runs whole
 // accelerated steps and needs all five.
 #include "acceleration.h"
 
@@ -44,18 +44,19 @@ double estimate_spectral_radius(const std::vector<double>& update_norms) {
 
 // TODO(lab11.4) [1 pt] The restart rule: true when objective_after is not
 // finite or exceeds objective_before + slack · |objective_before|.
-// Throw for a non-finite objective_before or a slack that is not finite and >= 0.
+// Throw for a non-finite objective_before, or a slack that is negative or not finite.
 // Graded by tests/lab11_acceleration/test_restart.cpp (1 pt).
 bool restart_needed(double objective_before, double objective_after, double slack) {
   (void)objective_before, (void)objective_after, (void)slack;
   not_implemented("restart_needed", __FILE__);
 }
 
-// TODO(lab11.5) [3 pts] The L-BFGS two-loop recursion with initial_inverse as
-// H₀ (see the header for the two loops). Skip every pair whose sᵀy is not > 0
-// in both loops; return d = −H ∇g. Throw when a pair's size differs from the
-// gradient's.
-// Graded by tests/lab11_acceleration/test_lbfgs.cpp (3 pts).
+// TODO(lab11.5) [4 pts] The L-BFGS two-loop recursion with initial_inverse as
+// H₀, applied as given (see the header for the two loops). Skip every pair
+// whose sᵀy is not > 0 in both loops; return d = −H ∇g. Throw when a pair's
+// size differs from the gradient's.
+// Graded by tests/lab11_acceleration/test_lbfgs.cpp (4 pts: the dense update,
+// then one case each for H₀ unscaled, the skip, and the loops' order).
 Eigen::VectorXd lbfgs_direction(const Eigen::VectorXd& gradient, const std::vector<CurvaturePair>& pairs,
                                 const InverseApply& initial_inverse) {
   (void)gradient, (void)pairs, (void)initial_inverse;

@@ -75,8 +75,8 @@ double estimate_spectral_radius(const std::vector<double>& update_norms);
 //               objective_after > objective_before + slack · |objective_before|
 //
 // slack (≥ 0, e.g. 1e-12) lets round-off through without a restart.
-// Throws std::invalid_argument for objective_before not finite or slack not
-// finite and ≥ 0.
+// Throws std::invalid_argument for objective_before not finite, or slack
+// negative or not finite.
 bool restart_needed(double objective_before, double objective_after, double slack);
 
 // One L-BFGS pair: s = x_(i+1) − x_i, y = ∇g(x_(i+1)) − ∇g(x_i), stacked.

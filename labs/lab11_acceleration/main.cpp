@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "accelerated.h"
@@ -32,22 +33,21 @@ struct LabOptions {
   int estimate_iterations = 400;
 };
 
-cl::Scene load(const cl::CommonOptions& options, const std::string& name, Method method) {
-  cl::CommonOptions one = options;
-  one.scene = name;
-  cl::Scene scene = cl::load_scene_for(one, CL_LAB_SCENE_DIR);
-  if (cl::lab11::minimises_objective(method)) {
+// The scenes of a run (--scene) or of --convergence (--sweep-scenes), each
+// refused when the chosen method minimises g and a spring is hard.
+std::vector<cl::Scene> load(const cl::CommonOptions& options, const std::vector<std::string>& names, Method method) {
+  std::vector<cl::Scene> scenes = cl::load_scenes(options, names, CL_LAB_SCENE_DIR);
+  for (const cl::Scene& scene : scenes) {
+    if (!cl::lab11::minimises_objective(method)) break;
     cl::require_finite_springs(scene,
                                std::string(cl::lab11::method_name(method)) + " needs finite springs (or a PBD method)");
   }
-  return scene;
+  return scenes;
 }
 
-// --rho, or ρ measured on the scene's first step (Wang: once per scene); 0 for
-// the methods without Chebyshev.
+// --rho, or ρ measured on the scene's first step (Wang: once per scene); 0 without Chebyshev.
 double rho_for(cl::lab11::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
-  if (!lab.estimate) return lab.settings.rho;
-  if (method != Method::kPdChebyshev && method != Method::kJacobiChebyshev) return 0.0;
+  if (!lab.estimate || (method != Method::kPdChebyshev && method != Method::kJacobiChebyshev)) return lab.settings.rho;
   cl::lab11::Settings settings = lab.settings;
   settings.gravity = scene.gravity;
   const double rho = solver.estimate_rho(scene.particles, method, settings, lab.estimate_iterations);
@@ -58,7 +58,7 @@ double rho_for(cl::lab11::Solver& solver, const cl::Scene& scene, Method method,
 
 int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab11::method_from_name(options.method);
-  cl::Scene scene = load(options, options.scene, method);
+  cl::Scene scene = std::move(load(options, {}, method).front());
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   cl::lab11::Settings& settings = lab.settings;
@@ -82,22 +82,19 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
               !chebyshev ? " (not used)" : lab.estimate ? " (estimated)" : "", settings.gamma, settings.delay,
               settings.history, scene.steps, scene.dt);
   if (!result.problem.empty()) std::printf("  DIVERGED at step %d: %s\n", result.problem_step, result.problem.c_str());
-  std::printf("  max strain %.3e, rms %.3e; %lld iterations, %d restarts, %d failed line searches; %.3e s (%.3e s "
-              "per step)\n", strain.max, strain.rms, result.iterations_done, result.restarts,
-              result.failed_line_searches, result.seconds, result.steps_done ? result.seconds / result.steps_done : 0.0);
+  std::printf("  max strain %.3e, rms %.3e; %lld iterations, %d restarts, %d failed line searches, %d descent "
+              "fallbacks; %.3e s (%.3e s per step)\n", strain.max, strain.rms, result.iterations_done, result.restarts,
+              result.failed_line_searches, result.descent_fallbacks, result.seconds,
+              result.steps_done ? result.seconds / result.steps_done : 0.0);
   if (!options.out.empty()) table.write(cl::join_path(options.out, "iterations.csv"));
   cl::print_trajectory_note(options, "step");
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
-    summary.extra["rho"] = settings.rho;
-    summary.extra["rho_estimated"] = lab.estimate;
-    summary.extra["gamma"] = settings.gamma;
-    summary.extra["delay"] = settings.delay;
-    summary.extra["history"] = settings.history;
-    summary.extra["restarts"] = result.restarts;
-    summary.extra["iterations_done"] = result.iterations_done;
-    summary.extra["failed_line_searches"] = result.failed_line_searches;
+    summary.extra.update(nlohmann::ordered_json{
+        {"rho", settings.rho}, {"rho_estimated", lab.estimate}, {"gamma", settings.gamma}, {"delay", settings.delay},
+        {"history", settings.history}, {"restarts", result.restarts}, {"iterations_done", result.iterations_done},
+        {"failed_line_searches", result.failed_line_searches}, {"descent_fallbacks", result.descent_fallbacks}});
     cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
     cl::write_summary(options.summary, summary);
   }
@@ -108,12 +105,12 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   cl::refuse_run_flags(options, "", "--convergence writes CSV files, not a run summary");
   const Method method = cl::lab11::method_from_name(options.method);
   const bool pd = cl::lab11::minimises_objective(method);
+  const std::vector<cl::Scene> scenes = load(options, lab.sweep_scenes, method);  // every refusal before any output
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::CsvTable table({"scene", "method", "rho", "history", "iteration", "objective", "objective_error", "max_strain",
                       "omega", "restarted", "seconds", "setup_seconds"});
   const std::vector<double> targets = pd ? std::vector<double>{1e-2, 1e-4, 1e-6} : std::vector<double>{lab.strain_target};
-  for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene} : lab.sweep_scenes) {
-    const cl::Scene scene = load(options, name, method);
+  for (const cl::Scene& scene : scenes) {
     cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
     cl::lab11::Settings settings = lab.settings;
     settings.gravity = scene.gravity;
@@ -152,7 +149,8 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
         std::printf("  %s %g: not in %d", pd ? "error" : "strain", targets[t], report.iterations_done);
       }
     }
-    std::printf("  restarts %d%s%s\n", report.restarts, report.problem.empty() ? "" : "; ", report.problem.c_str());
+    std::printf("  restarts %d, descent fallbacks %d%s%s\n", report.restarts, report.descent_fallbacks,
+                report.problem.empty() ? "" : "; ", report.problem.c_str());
     std::fflush(stdout);
   }
   if (!options.out.empty()) table.write(cl::join_path(options.out, "convergence.csv"));
@@ -173,23 +171,24 @@ int main(int argc, char** argv) {
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
   double rho = -1.0;
+  const std::vector<std::string> chebyshev{"pd-chebyshev", "jacobi-chebyshev"};
   app.add_option("--rho", rho, "the spectral radius for Chebyshev, in [0, 1) (default: estimated per scene)")
-      .non_negative();
+      .non_negative().only_for_methods(chebyshev);
   app.add_option("--gamma", lab.settings.gamma, "Chebyshev's under-relaxation, in (0, 2)")
-      .positive().capture_default_str();
+      .positive().capture_default_str().only_for_methods(chebyshev);
   app.add_option("--delay", lab.settings.delay, "S: plain iterations before Chebyshev starts (>= 1)")
-      .range(1, 1'000'000).capture_default_str();
+      .range(1, 1'000'000).capture_default_str().only_for_methods(chebyshev);
   app.add_option("--history", lab.settings.history, "m: L-BFGS pairs kept (>= 0)")
-      .range(0, 1000).capture_default_str();
+      .range(0, 1000).capture_default_str().only_for_methods({"pd-lbfgs"});
   app.add_option("--tolerance", lab.settings.tolerance,
                  "stop a step once the objective's relative decrease falls below this (0: run all K; PD methods)")
-      .non_negative().capture_default_str();
+      .non_negative().capture_default_str().only_for_methods({"pd", "pd-chebyshev", "pd-lbfgs", "newton"});
   app.add_option("--estimate-iterations", lab.estimate_iterations, "plain iterations that estimate rho (no --rho)")
-      .range(2, 1'000'000).capture_default_str();
+      .range(2, 1'000'000).capture_default_str().only_for_methods(chebyshev);
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   app.add_option("--strain-target", lab.strain_target, "--convergence, PBD methods: the max strain to reach")
-      .positive().capture_default_str();
+      .positive().capture_default_str().only_for_methods({"jacobi", "jacobi-chebyshev", "gauss-seidel"});
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1) (the iteration would not converge)");
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");

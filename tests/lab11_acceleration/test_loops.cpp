@@ -1,7 +1,8 @@
 // Graded tests of whole accelerated steps (given code around all five
 // functions): the accelerated methods converge to lab 06's Newton minimiser,
 // restarts never raise the objective, ρ = 0 is the plain iteration bit for
-// bit, L-BFGS with m = 0 is projective dynamics.
+// bit, L-BFGS with m = 0 is projective dynamics, and its directions descend
+// without the given loop's fallback.
 #include <cmath>
 #include <random>
 #include <string>
@@ -241,6 +242,30 @@ TEST_CASE("converged L-BFGS equals the Newton minimiser to 1e-8 and g never rise
         CAPTURE(k, g[k - 1], g[k]);
         REQUIRE(g[k] <= g[k - 1] + 64.0 * 2.220446049250313e-16 * std::abs(g[k - 1]));
       }
+    }
+  }
+}
+
+TEST_CASE("on a well-posed scene every L-BFGS direction descends and none falls back to the PD direction", "[lab11][pts=1]") {
+  // The given loop replaces a direction that is not a descent by −A⁻¹∇g and
+  // forgets the history (StepReport::descent_fallbacks): a recursion of the
+  // wrong sign, or one that uses a pair with sᵀy <= 0, then runs as plain PD
+  // and still converges, so the cases above cannot see it. A correct
+  // recursion keeps H positive definite and never needs the fallback.
+  std::mt19937_64 rng(1114);
+  std::vector<Case> cases;
+  for (int trial = 0; trial < 3; ++trial) cases.push_back(random_case(rng, trial));
+  const cl::Scene scene = lab06_test::cloth(10, 1e4);
+  cases.push_back({scene.particles, scene.springs, scene.dt, scene.gravity});
+  for (std::size_t index = 0; index < cases.size(); ++index) {
+    for (const int history : {1, 5, 20}) {
+      cl::lab11::Settings settings;
+      settings.history = history;
+      settings.iterations = 3000;
+      cl::lab11::StepReport report;
+      run(cases[index], Method::kPdLbfgs, settings, nullptr, &report);
+      CAPTURE(index, history, report.iterations_done);
+      REQUIRE(cl::test::at_most("descent fallbacks", report.descent_fallbacks, 0));
     }
   }
 }
