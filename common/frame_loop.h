@@ -1,5 +1,5 @@
 #pragma once
-// The one frame loop of every time-stepping lab (04–12): it steps a state
+// The one frame loop of every time-stepping lab (04–13): it steps a state
 // frame by frame, measures it after every frame, and owns what every lab
 // decides alike — the health verdict (common/health.h), the energy verdict,
 // the settle windows (common/window_means.h), the per-frame CSV history, the

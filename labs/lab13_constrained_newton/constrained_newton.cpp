@@ -21,7 +21,7 @@ Residuals residuals(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
   not_implemented("residuals", __FILE__);
 }
 
-// TODO(lab13.2) [3 pts] v̂ = (y − x)/Δt − Δt g for every unknown, stacked.
+// TODO(lab13.2) [7 pts] v̂ = (y − x)/Δt − Δt g for every unknown, stacked.
 // Graded by tests/lab13_constrained_newton/test_first_iteration.cpp (the first
 // iteration is lab 09's step) and test_rebased.cpp.
 Eigen::VectorXd rebased_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const MovableMap& map,
@@ -40,7 +40,7 @@ Eigen::VectorXd warm_start(const Eigen::Matrix3Xd& x, const std::vector<Spring>&
   not_implemented("warm_start", __FILE__);
 }
 
-// TODO(lab13.4) [3 pts] force_error = ‖force‖∞ / max(‖inertia‖∞,
+// TODO(lab13.4) [4 pts] force_error = ‖force‖∞ / max(‖inertia‖∞,
 // ‖constraint_force‖∞) (0 when ‖force‖∞ = 0), constraint_error =
 // ‖constraint‖∞ / length_scale, converged when both ≤ tolerance.
 // Graded by tests/lab13_constrained_newton/test_convergence.cpp.

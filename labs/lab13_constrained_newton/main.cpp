@@ -98,7 +98,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
               settings.tolerance, scene.steps, scene.dt);
   if (!result.problem.empty()) cl::print_stopped("DIVERGED", "step", result.problem_step, scene.dt, result.problem);
   std::printf("  max strain %.3e; %lld iterations (%.2f per step), %d backtracks, %d failed decreases, "
-              "%d fallbacks to dropped compression, %d steps not converged\n",
+              "%d fallback solves, %d steps not converged\n",
               strain.max, result.iterations_done,
               result.steps_done ? static_cast<double>(result.iterations_done) / result.steps_done : 0.0,
               result.backtracks, result.failed_decreases, result.fallbacks, result.unconverged_steps);
@@ -145,16 +145,16 @@ int main(int argc, char** argv) {
   LabOptions lab;
   std::string start = "x", warm = "forces", compression = "keep";
   app.add_option("--start", start, "constrained-newton's first iterate: x (the step's start) or prediction (y)")
-      .one_of({"x", "prediction"}).capture_default_str();
+      .one_of({"x", "prediction"}).capture_default_str().only_for_methods({"constrained-newton"});
   app.add_option("--warm", warm, "constrained-newton's first multipliers: forces (the springs' at the start) or zero")
-      .one_of({"forces", "zero"}).capture_default_str();
+      .one_of({"forces", "zero"}).capture_default_str().only_for_methods({"constrained-newton"});
   app.add_option("--tolerance", lab.settings.tolerance,
                  "constrained-newton: stop once the force and constraint errors are both below this (0: every iteration)")
-      .non_negative().capture_default_str();
+      .non_negative().capture_default_str().only_for_methods({"constrained-newton"});
   app.add_option("--stiffness", lab.stiffness, "every spring's stiffness, N/m, or inf (hard); default: the scene's");
   app.add_option("--compression", compression,
                  "compressed springs in K_g: keep (exact; dropped where not definite) or drop (always)")
-      .one_of({"drop", "keep"}).capture_default_str();
+      .one_of({"drop", "keep"}).capture_default_str().only_for_methods({"constrained-newton"});
   app.add_flag("--convergence", lab.convergence, "one step to convergence against k: convergence.csv, crossover.csv");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   app.add_option("--stiffnesses", lab.stiffnesses, "--convergence: the stiffnesses, N/m or inf").delimiter(',')
