@@ -1,26 +1,23 @@
 """Lab 11 figures: one step's convergence, accelerated against plain.
 
-Usage: /usr/bin/python3 plots/lab11_convergence.py OUTDIR
+Usage: /usr/bin/python3 plots/lab11_convergence.py [OUTDIR]
 Reads every OUTDIR/lab11_acceleration/**/convergence.csv, written by the
 --convergence lines of labs/lab11_acceleration/demo.txt, and writes in
 OUTDIR/lab11_acceleration/, per scene:
   convergence_<scene>.png  PD family: relative objective error (g - g*)/g* against
                            iteration (left) and wall time (right), log scales
   pbd_<scene>.png          PBD family: max strain against sweep, log scale
-Exit 4 when the data are absent.
+A figure newer than every table it is drawn from is left as it is; exit 4
+(the shared skip rule, _figures.py) when the data are absent.
 """
-import csv
-import sys
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import _figures as figures
+from _figures import plt
 
 LAB = "lab11_acceleration"
-COMMAND = ("./course run lab11 --convergence --scene pd-curtain-32 --method pd-chebyshev "
-           "--out out/lab11_acceleration/chebyshev (or ./course demo)")
+COMMAND = ("./course demo  (or: " + figures.make_command(
+    LAB, "--convergence --scene pd-curtain-32 --method pd-chebyshev --out out/lab11_acceleration/chebyshev") + ")")
 FLOOR = 1e-17  # an error of exactly 0 is drawn here
 PBD = {"jacobi", "jacobi-chebyshev", "gauss-seidel"}
 
@@ -35,12 +32,15 @@ def label(row):
 
 
 def read_runs(paths):
-    """{scene: {label: [rows]}} over every table; later tables keep their own curves."""
+    """{(scene, family): ({label: [rows]}, {the tables they come from})}, family
+    "pd" or "pbd" (the two figures); later tables keep their own curves."""
     runs = {}
     for path in paths:
-        with open(path, newline="") as handle:
-            for row in csv.DictReader(handle):
-                runs.setdefault(row["scene"], {}).setdefault(label(row), []).append(row)
+        for row in figures.rows(path):
+            family = "pbd" if row["method"] in PBD else "pd"
+            curves, sources = runs.setdefault((row["scene"], family), ({}, set()))
+            curves.setdefault(label(row), []).append(row)
+            sources.add(path)
     return runs
 
 
@@ -63,8 +63,7 @@ def draw_pd(scene, curves, path):
     by_time.set_xlabel("wall time of the step, factorization included (s)")
     figure.suptitle(f"Lab 11: one implicit-Euler step of {scene}; g* = lab 06's Newton minimum")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
 def draw_pbd(scene, curves, path):
@@ -80,28 +79,20 @@ def draw_pbd(scene, curves, path):
     axis.legend(fontsize=8)
     axis.set_title(f"Lab 11: one PBD step of {scene}")
     figure.tight_layout()
-    figure.savefig(path, dpi=120)
-    plt.close(figure)
+    figures.save(figure, path, dpi=120)
 
 
-def main(argv):
-    if len(argv) != 2:
-        print("usage: plots/lab11_convergence.py OUTDIR", file=sys.stderr)
-        return 2
-    lab_dir = Path(argv[1]) / LAB
+def main(out_dir):
+    lab_dir = Path(out_dir) / LAB
     tables = sorted(lab_dir.rglob("convergence.csv")) if lab_dir.is_dir() else []
     if not tables:
-        print(f"lab11_convergence: no convergence.csv under {lab_dir}; make one with {COMMAND}", file=sys.stderr)
-        return 4
-    for scene, curves in read_runs(tables).items():
-        pd = {name: rows for name, rows in curves.items() if rows[0]["method"] not in PBD}
-        pbd = {name: rows for name, rows in curves.items() if rows[0]["method"] in PBD}
-        if pd:
-            draw_pd(scene, pd, lab_dir / f"convergence_{scene}.png")
-        if pbd:
-            draw_pbd(scene, pbd, lab_dir / f"pbd_{scene}.png")
+        return figures.skip("lab11_convergence", f"no convergence.csv under {lab_dir}; make one with {COMMAND}")
+    for (scene, family), (curves, sources) in read_runs(tables).items():
+        target = lab_dir / (f"convergence_{scene}.png" if family == "pd" else f"pbd_{scene}.png")
+        if not figures.up_to_date(target, sorted(sources)):
+            (draw_pd if family == "pd" else draw_pbd)(scene, curves, target)
     return 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv))
+    figures.run(main)
