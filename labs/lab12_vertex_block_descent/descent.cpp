@@ -4,12 +4,15 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
 #include "accelerated.h"
 #include "common/health.h"
 #include "common/metrics.h"
+#include "common/output.h"
 #include "common/timer.h"
 
 namespace cl::lab12 {
@@ -67,6 +70,35 @@ Adjacency make_adjacency(int particles, const std::vector<Spring>& springs) {
     if (s.j != s.i) adjacency.springs[static_cast<std::size_t>(fill[static_cast<std::size_t>(s.j)]++)] = static_cast<int>(e);
   }
   return adjacency;
+}
+
+double vertex_energy_change(const lab06::Problem& problem, const Adjacency& adjacency, const Eigen::Matrix3Xd& x,
+                            const Eigen::Matrix3Xd& y, int vertex, const Eigen::Vector3d& step) {
+  const Eigen::Index n = problem.inv_mass.size();
+  if (x.cols() != n || y.cols() != n || vertex < 0 || vertex >= n ||
+      adjacency.offsets.size() != static_cast<std::size_t>(n) + 1) {
+    throw std::invalid_argument("vertex_energy_change: vertex " + std::to_string(vertex) + " outside [0, " +
+                                std::to_string(n) + "), or x, y or the adjacency not for these particles");
+  }
+  // Each difference as a product with the step, never E(after) − E(before):
+  // the line search compares changes far smaller than E_i itself.
+  double change = 0.0;
+  const double inv_mass = problem.inv_mass[vertex];
+  if (inv_mass > 0.0) {
+    const Eigen::Vector3d r = x.col(vertex) - y.col(vertex);
+    change += step.dot(2.0 * r + step) / (2.0 * inv_mass * problem.dt * problem.dt);
+  }
+  const auto v = static_cast<std::size_t>(vertex);
+  for (int a = adjacency.offsets[v]; a < adjacency.offsets[v + 1]; ++a) {
+    const Spring& spring = problem.springs[static_cast<std::size_t>(adjacency.springs[static_cast<std::size_t>(a)])];
+    const int other = spring.i == vertex ? spring.j : spring.i;
+    const Eigen::Vector3d edge = x.col(vertex) - x.col(other);
+    const double before = edge.norm(), after = (edge + step).norm();
+    if (!(before + after > 0.0)) continue;  // both coincident: the length does not change
+    const double lengthening = step.dot(2.0 * edge + step) / (before + after);  // l' − l
+    change += 0.5 * spring.stiffness * lengthening * (after + before - 2.0 * spring.rest_length);
+  }
+  return change;
 }
 
 std::vector<std::vector<int>> colour_groups(const std::vector<int>& colours, const Eigen::VectorXd& inv_mass) {
@@ -242,6 +274,82 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
 
 std::vector<std::string> step_columns() {
   return {"objective", "iterations", "converged", "restarts", "seconds", "max_strain", "rms_strain", "total_energy"};
+}
+
+// ------------------------------------------------------------------ experiment 2
+
+namespace {
+
+const std::vector<double> kTableStiffness{1e2, 1e4, 1e6, 1e8, 1e10, 1e12};
+const std::vector<double> kTableDt{1e-4, 1e-3, 1e-2, 0.1, 0.5};
+const std::vector<int> kTableIterations{1, 10, 100};
+
+// The kind of a stop, for the table's counts: the message up to its first
+// number, so that "energy rose by 14.2 J" and "energy rose by 3e5 J" count as one.
+std::string kind_of(const std::string& problem) {
+  const std::size_t digit = problem.find_first_of("0123456789");
+  std::string kind = problem.substr(0, digit);
+  while (!kind.empty() && (kind.back() == ' ' || kind.back() == '(' || kind.back() == ':')) kind.pop_back();
+  return kind;
+}
+
+}  // namespace
+
+std::vector<StabilityCell> stability_cells(const Scene& scene, Method method, const Settings& settings) {
+  std::vector<StabilityCell> cells;
+  for (const double stiffness : kTableStiffness) {
+    for (const double dt : kTableDt) {
+      for (const int iterations : kTableIterations) {
+        Scene cell = scene;
+        for (Spring& spring : cell.springs) spring.stiffness = stiffness;
+        Solver solver(cell.particles.inv_mass, cell.springs, dt);
+        Settings run = settings;
+        run.gravity = scene.gravity;
+        run.iterations = iterations;
+        cells.push_back({stiffness, dt, iterations, run_steps(cell.particles, solver, method, run, cell.steps)});
+      }
+    }
+  }
+  return cells;
+}
+
+std::string stability_markdown(const std::vector<StabilityCell>& cells) {
+  std::ostringstream text;
+  text << "| k (N/m) \\ Δt (s) |";
+  for (const double dt : kTableDt) text << " " << format_double(dt) << " |";
+  text << "\n|---|";
+  for (std::size_t c = 0; c < kTableDt.size(); ++c) text << "---|";
+  std::map<std::string, int> kinds;
+  std::size_t next = 0;
+  for (const double stiffness : kTableStiffness) {
+    text << "\n| " << format_double(stiffness) << " |";
+    for (std::size_t c = 0; c < kTableDt.size(); ++c) {
+      for (std::size_t k = 0; k < kTableIterations.size() && next < cells.size(); ++k, ++next) {
+        const RunResult& result = cells[next].result;
+        text << (k ? " / " : " ");
+        if (result.problem.empty()) {
+          text << "✓";
+        } else {
+          text << "✗" << result.problem_step;
+          ++kinds[kind_of(result.problem)];
+        }
+      }
+      text << " |";
+    }
+  }
+  text << "\n";
+  for (const auto& [kind, count] : kinds) text << "  stopped " << count << " times: " << kind << "\n";
+  return text.str();
+}
+
+CsvTable stability_csv(const std::vector<StabilityCell>& cells) {
+  CsvTable table({"stiffness", "dt", "iterations", "steps_done", "stopped_at_step", "problem"});
+  for (const StabilityCell& cell : cells) {
+    const RunResult& r = cell.result;
+    table.add_row({cell.stiffness, cell.dt, static_cast<long long>(cell.iterations), static_cast<long long>(r.steps_done),
+                   cell_if(!r.problem.empty(), r.problem_step), r.problem});
+  }
+  return table;
 }
 
 }  // namespace cl::lab12

@@ -15,8 +15,10 @@
 
 #include "../lab06_projective_dynamics/simulation.h"
 #include "accelerated.h"
+#include "common/csv.h"
 #include "common/frame_loop.h"
 #include "common/particles.h"
+#include "common/scene.h"
 #include "vbd.h"
 
 namespace cl::lab12 {
@@ -136,5 +138,29 @@ RunResult run_steps(Particles& particles, Solver& solver, Method method, const S
 
 // objective, iterations, converged, restarts, seconds, max_strain, rms_strain, total_energy.
 std::vector<std::string> step_columns();
+
+// ------------------------------------------------------------------ experiment 2
+
+// One cell of the stability table (README.md, experiment 2): the scene with
+// every spring at `stiffness` and the step `dt`, run for the scene's steps
+// with K = `iterations` sweeps per step.
+struct StabilityCell {
+  double stiffness = 0.0;  // N/m
+  double dt = 0.0;         // s
+  int iterations = 0;
+  RunResult result;
+};
+
+// The table's grid: k = 1e2, 1e4, …, 1e12 N/m; Δt = 1e-4, 1e-3, 1e-2, 0.1, 0.5 s; K = 1, 10, 100.
+// Cells in the order k, then Δt, then K; gravity is the scene's, settings.rho 0 plain VBD.
+std::vector<StabilityCell> stability_cells(const Scene& scene, Method method, const Settings& settings);
+
+// The table as README.md shows it: a row per k, a column per Δt, each cell
+// "a / b / c" for K = 1, 10, 100 with ✓ (every step healthy) or ✗n (stopped
+// at step n), then one line per kind of stop with its count.
+std::string stability_markdown(const std::vector<StabilityCell>& cells);
+
+// stiffness, dt, iterations, steps_done, stopped_at_step (empty: none), problem.
+CsvTable stability_csv(const std::vector<StabilityCell>& cells);
 
 }  // namespace cl::lab12

@@ -1,10 +1,10 @@
 // Lab 12 — your code. Read vbd.h (the contract) and README.md (the
 // derivations) first. Grade with:  ./course grade lab12
 //
-// The four functions below are the pieces of vertex block descent; the given
+// The five functions below are the pieces of vertex block descent; the given
 // code (descent.cpp) runs them inside the step. Besides the tests named in
-// each block, tests/lab12_vertex_block_descent/test_minimiser.cpp (6 pts)
-// runs whole sweeps and needs all four.
+// each block, tests/lab12_vertex_block_descent/test_minimiser.cpp (8 pts)
+// runs whole sweeps and needs all five.
 #include "vbd.h"
 
 #include "common/not_implemented.h"
@@ -22,16 +22,27 @@ VertexBlock vertex_block(const lab06::Problem& problem, const Adjacency& adjacen
   not_implemented("vertex_block", __FILE__);
 }
 
-// TODO(lab12.2) [2 pts] Δx = H⁻¹ f, or a zero vector for a pinned vertex, a
+// TODO(lab12.2) [1 pt] d = H⁻¹ f, or a zero vector for a pinned vertex, a
 // non-finite block, a near-singular H (|det H| <= kSingularDeterminant · s³,
 // s the largest |entry|) or a non-finite result.
-// Graded by tests/lab12_vertex_block_descent/test_update.cpp (2 pts).
-Eigen::Vector3d vertex_update(const VertexBlock& block, double inv_mass) {
+// Graded by tests/lab12_vertex_block_descent/test_update.cpp (the first case).
+Eigen::Vector3d vertex_newton_step(const VertexBlock& block, double inv_mass) {
   (void)block, (void)inv_mass;
+  not_implemented("vertex_newton_step", __FILE__);
+}
+
+// TODO(lab12.3) [2 pts] The guarded vertex update: d from vertex_newton_step,
+// then α = 1, 1/2, 1/4, … (at most kMaxHalvings halvings) until
+// vertex_energy_change(…, α d) <= −kSufficientDecrease · α · fᵀd; return α d,
+// or a zero vector when d is zero or no α passes.
+// Graded by tests/lab12_vertex_block_descent/test_update.cpp (the other cases).
+Eigen::Vector3d vertex_update(const lab06::Problem& problem, const Adjacency& adjacency, const Eigen::Matrix3Xd& x,
+                              const Eigen::Matrix3Xd& y, int vertex) {
+  (void)problem, (void)adjacency, (void)x, (void)y, (void)vertex;
   not_implemented("vertex_update", __FILE__);
 }
 
-// TODO(lab12.3) [2 pts] The greedy colouring: particles in index order, each
+// TODO(lab12.4) [2 pts] The greedy colouring: particles in index order, each
 // the smallest colour none of its coloured neighbours has.
 // Graded by tests/lab12_vertex_block_descent/test_colouring.cpp (2 pts).
 std::vector<int> colour_particles(int particles, const std::vector<Spring>& springs) {
@@ -39,8 +50,8 @@ std::vector<int> colour_particles(int particles, const std::vector<Spring>& spri
   not_implemented("colour_particles", __FILE__);
 }
 
-// TODO(lab12.4) [3 pts] One sweep: groups in order, the particles of a group
-// in an OpenMP parallel for, each x_p += vertex_update(vertex_block(...)).
+// TODO(lab12.5) [3 pts] One sweep: groups in order, the particles of a group
+// in an OpenMP parallel for, each x_p += vertex_update(problem, adjacency, x, y, p).
 // Graded by tests/lab12_vertex_block_descent/test_sweep.cpp (3 pts).
 void vbd_sweep(const lab06::Problem& problem, const Adjacency& adjacency, const std::vector<std::vector<int>>& groups,
                const Eigen::Matrix3Xd& y, Eigen::Matrix3Xd& x) {

@@ -63,7 +63,7 @@ VertexBlock vertex_block(const lab06::Problem& problem, const Adjacency& adjacen
   return block;
 }
 
-Eigen::Vector3d vertex_update(const VertexBlock& block, double inv_mass) {
+Eigen::Vector3d vertex_newton_step(const VertexBlock& block, double inv_mass) {
   const Eigen::Vector3d none = Eigen::Vector3d::Zero();
   if (!(inv_mass > 0.0) || !block.force.allFinite() || !block.hessian.allFinite()) return none;
   const double scale = block.hessian.cwiseAbs().maxCoeff();
@@ -73,6 +73,23 @@ Eigen::Vector3d vertex_update(const VertexBlock& block, double inv_mass) {
   if (!(std::abs(scaled.determinant()) > kSingularDeterminant)) return none;
   const Eigen::Vector3d step = scaled.ldlt().solve(block.force) / scale;
   return step.allFinite() ? step : none;
+}
+
+Eigen::Vector3d vertex_update(const lab06::Problem& problem, const Adjacency& adjacency, const Eigen::Matrix3Xd& x,
+                              const Eigen::Matrix3Xd& y, int vertex) {
+  const VertexBlock block = vertex_block(problem, adjacency, x, y, vertex);
+  const Eigen::Vector3d direction = vertex_newton_step(block, problem.inv_mass[vertex]);
+  const Eigen::Vector3d none = Eigen::Vector3d::Zero();
+  const double slope = block.force.dot(direction);  // f·d = dᵀHd > 0 for a descent direction
+  if (!(slope > 0.0)) return none;
+  double alpha = 1.0;
+  for (int halving = 0; halving <= kMaxHalvings; ++halving, alpha *= 0.5) {
+    const Eigen::Vector3d step = alpha * direction;
+    if (vertex_energy_change(problem, adjacency, x, y, vertex, step) <= -kSufficientDecrease * alpha * slope) {
+      return step;
+    }
+  }
+  return none;
 }
 
 std::vector<int> colour_particles(int particles, const std::vector<Spring>& springs) {
@@ -109,7 +126,7 @@ void vbd_sweep(const lab06::Problem& problem, const Adjacency& adjacency, const 
   require_shape(x, n, "vbd_sweep: x");
   require_shape(y, n, "vbd_sweep: y");
   const auto update = [&](int p) {
-    x.col(p) += vertex_update(vertex_block(problem, adjacency, x, y, p), problem.inv_mass[p]);
+    x.col(p) += vertex_update(problem, adjacency, x, y, p);
   };
 #ifdef _OPENMP
   // One team per sweep and a barrier per colour. On one thread no team at

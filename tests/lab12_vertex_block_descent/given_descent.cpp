@@ -73,3 +73,40 @@ TEST_CASE("rho = 0 is plain VBD bit for bit, and Chebyshev never raises g over a
   REQUIRE(report.problem.empty());
   REQUIRE(accelerated.col(0) == y.col(0));
 }
+
+TEST_CASE("the vertex energy change is g's change, and keeps its first-order term for tiny steps", "[lab12_given]") {
+  std::mt19937_64 rng(1214);
+  for (int trial = 0; trial < 6; ++trial) {
+    cl::Particles start = lab12_test::random_particles(rng, 9);
+    start.inv_mass[trial] = 0.0;
+    std::vector<cl::Spring> springs = lab12_test::random_springs(rng, start.x, 9, 0.3, 3.0, 0.0, 4.0);
+    springs.push_back({7, 8, 0.0, 50.0});  // a zero-rest spring too
+    const cl::lab06::Problem problem = cl::lab06::make_problem(start.inv_mass, springs, 0.05);
+    const cl::lab12::Adjacency adjacency = cl::lab12::make_adjacency(9, springs);
+    const Eigen::Matrix3Xd y = cl::lab06::predict(start, Eigen::Vector3d(0.0, -9.81, 0.0), 0.05);
+    const Eigen::Matrix3Xd& x = start.x;
+    const double g = cl::lab06::objective(problem, x, y);
+    const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
+    CAPTURE(trial);
+    for (int p = 0; p < 9; ++p) {
+      const Eigen::Vector3d step = 0.3 * Eigen::Vector3d::Random();
+      Eigen::Matrix3Xd moved = x;
+      moved.col(p) += step;
+      CAPTURE(p, step.transpose());
+      REQUIRE(cl::test::near(cl::lab12::vertex_energy_change(problem, adjacency, x, y, p, step),
+                             cl::lab06::objective(problem, moved, y) - g, 1e-12 * g));
+      // A step of 1e-12 m: g's own difference is round-off; the change is its
+      // first-order term −f·s to 1e-6 relative.
+      const int u = problem.map.unknown_of[static_cast<std::size_t>(p)];
+      if (u < 0) continue;
+      const Eigen::Vector3d tiny = -1e-12 * gradient.segment<3>(3 * u).normalized();
+      const double first_order = gradient.segment<3>(3 * u).dot(tiny);
+      REQUIRE(cl::test::near_rel(cl::lab12::vertex_energy_change(problem, adjacency, x, y, p, tiny), first_order, 1e-6));
+    }
+  }
+  cl::Particles start = lab12_test::random_particles(rng, 3);
+  const cl::lab06::Problem problem = cl::lab06::make_problem(start.inv_mass, {{0, 1, 1.0, 1.0}}, 0.05);
+  const cl::lab12::Adjacency adjacency = cl::lab12::make_adjacency(3, problem.springs);
+  REQUIRE_THROWS_AS(cl::lab12::vertex_energy_change(problem, adjacency, start.x, start.x, 3, Eigen::Vector3d::Ones()),
+                    std::invalid_argument);
+}

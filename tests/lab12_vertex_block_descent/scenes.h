@@ -34,6 +34,32 @@ inline std::vector<cl::Spring> grid_springs(int nx, int ny, double h, double k, 
   return springs;
 }
 
+// The three particles (gravity 0, Δt = 0.1 s, at rest): 0 and 2 of
+// 1 kg, the light 1 of 1 g between them; spring 0–1 (k = 10 N/m, L = 1 m) at
+// 1.1 m, stretched, and spring 1–2 (k = 1 N/m, L = 10 m) at 1 m, compressed
+// and at a right angle to it. Vertex 1's full Newton step throws it 4.6 m
+// across the stiff spring (its block sees that spring's curvature where it
+// is, 1.1 m long), which ends 4.7 m long: g goes from 40.55 J to 79.78 J in
+// the first sweep without a line search (README.md, "The line search").
+struct ThreeParticles {
+  cl::Particles particles;
+  std::vector<cl::Spring> springs;
+  double dt = 0.1;
+  Eigen::Vector3d gravity = Eigen::Vector3d::Zero();
+};
+
+inline ThreeParticles three_particles() {
+  ThreeParticles scene;
+  scene.particles.x.resize(3, 3);
+  scene.particles.x << 0.0, 1.1, 1.1,  //
+      0.0, 0.0, -1.0,                  //
+      0.0, 0.0, 0.0;
+  scene.particles.v = Eigen::Matrix3Xd::Zero(3, 3);
+  scene.particles.inv_mass = Eigen::Vector3d(1.0, 1000.0, 1.0);
+  scene.springs = {{0, 1, 1.0, 10.0}, {1, 2, 10.0, 1.0}};
+  return scene;
+}
+
 inline Eigen::Matrix3Xd grid_positions(int nx, int ny, double h) {
   Eigen::Matrix3Xd x(3, nx * ny);
   for (int j = 0; j < ny; ++j) {

@@ -1,4 +1,4 @@
-// Graded tests of lab12.3: the greedy colouring is valid, deterministic and greedy.
+// Graded tests of lab12.4: the greedy colouring is valid, deterministic and greedy.
 #include <algorithm>
 #include <random>
 #include <set>

@@ -1,8 +1,11 @@
-// Graded tests of whole steps (all four functions, in the given step of
+// Graded tests of whole steps (all five functions, in the given step of
 // descent.cpp): converged VBD is lab 06's Newton minimiser, it steps a linear
-// oscillator exactly, and the degenerate scenes stay finite.
+// oscillator exactly, the degenerate scenes stay finite, and g never rises
+// over a sweep where a full Newton step would raise it.
 #include <cmath>
+#include <limits>
 #include <random>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -113,5 +116,66 @@ TEST_CASE("coincident ends and zero-rest springs stay finite over whole runs; pi
       REQUIRE(particles.x.col(0) == Vector3d::Zero());
       REQUIRE(cl::test::at_least("spread of the particles", (particles.x.col(1) - particles.x.col(3)).norm(), 1e-6));
     }
+  }
+}
+
+TEST_CASE("g never rises over a sweep or a step of the three-particle scene", "[lab12][pts=1]") {
+  // Without the line search the first sweep takes g from 40.55 J to 79.78 J
+  // (scenes.h). Every sweep of every step, plain and with Chebyshev (whose
+  // restart rule then judges a sweep that did not climb), must not raise it.
+  for (const cl::lab12::Method method : {cl::lab12::Method::kVbd, cl::lab12::Method::kVbdChebyshev}) {
+    lab12_test::ThreeParticles scene = lab12_test::three_particles();
+    cl::lab12::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+    cl::lab12::Settings settings;
+    settings.gravity = scene.gravity;
+    settings.iterations = 10;
+    settings.rho = method == cl::lab12::Method::kVbdChebyshev ? 0.5 : 0.0;
+    for (int step = 1; step <= 5; ++step) {
+      double previous = std::numeric_limits<double>::infinity();
+      const cl::lab12::StepReport report =
+          solver.step(scene.particles, method, settings, [&](const cl::lab12::IterationRecord& r) {
+            CAPTURE(cl::lab12::method_name(method), step, r.iteration, previous, r.objective);
+            REQUIRE(cl::test::at_most("g after the sweep", r.objective, previous + 1e-13 * std::abs(previous)));
+            previous = r.objective;
+            return false;
+          });
+      CAPTURE(cl::lab12::method_name(method), step, report.problem);
+      REQUIRE(report.problem.empty());
+    }
+  }
+}
+
+TEST_CASE("g never rises within a step on random small chains", "[lab12][pts=1]") {
+  // The issue's chains: 3 to 8 particles, velocities, rest lengths 0.1 to 10
+  // times the length, k from 1 to 1e4 N/m, Δt = 0.1 s, three sweeps each; a
+  // full-step sweep raised g on 7 of 200.
+  std::mt19937_64 rng(1213);
+  std::uniform_int_distribution<int> size(3, 8);
+  std::uniform_real_distribution<double> exponent(-1.0, 1.0), log_k(0.0, 4.0);
+  for (int chain = 0; chain < 200; ++chain) {
+    const int n = size(rng);
+    cl::Particles start = lab12_test::random_particles(rng, n);
+    start.v *= 3.0;
+    std::vector<cl::Spring> springs;
+    for (int p = 0; p + 1 < n; ++p) {
+      const double length = (start.x.col(p) - start.x.col(p + 1)).norm();
+      springs.push_back({p, p + 1, length * std::pow(10.0, exponent(rng)), std::pow(10.0, log_k(rng))});
+    }
+    std::vector<double> rest, stiffness;
+    for (const cl::Spring& s : springs) rest.push_back(s.rest_length), stiffness.push_back(s.stiffness);
+    CAPTURE(chain, start.x, start.v, start.inv_mass.transpose(), rest, stiffness);
+    cl::lab12::Solver solver(start.inv_mass, springs, 0.1);
+    cl::lab12::Settings settings;
+    settings.iterations = 3;
+    settings.init = cl::lab12::Init::kInertia;
+    double previous = std::numeric_limits<double>::infinity();
+    const cl::lab12::StepReport report =
+        solver.step(start, cl::lab12::Method::kVbd, settings, [&](const cl::lab12::IterationRecord& r) {
+          CAPTURE(r.iteration, previous, r.objective);
+          REQUIRE(cl::test::at_most("g after the sweep", r.objective, previous + 1e-13 * std::abs(previous)));
+          previous = r.objective;
+          return false;
+        });
+    REQUIRE(report.problem.empty());
   }
 }
