@@ -1,10 +1,12 @@
-// Graded tests of lab12.4: the coloured sweep is Gauss-Seidel over the
+// Graded tests of lab12.5: the coloured sweep is Gauss-Seidel over the
 // vertices in colour order, never raises g, and gives the same bits on one
 // and two threads.
 #include <omp.h>
 
 #include <cmath>
+#include <cstring>
 #include <random>
+#include <string>
 
 #include <catch2/catch.hpp>
 
@@ -41,6 +43,36 @@ Cloth cloth(int n, double k, double dt, unsigned seed) {
   return c;
 }
 
+// Bit-for-bit equality of two runs, which on a failure leads with the first
+// particle that differs (both values in 17 digits) and how many do, never
+// the whole matrices (docs/DESIGN.md §4).
+cl::test::Check same_bits(const Eigen::Matrix3Xd& one, const Eigen::Matrix3Xd& two) {
+  cl::test::Check check;
+  if (one.cols() != two.cols()) {
+    check.text = "shapes differ: 3 x " + std::to_string(one.cols()) + " on one thread, 3 x " +
+                 std::to_string(two.cols()) + " on two";
+    return check;
+  }
+  Eigen::Index first = -1, row = 0, differing = 0;
+  for (Eigen::Index p = 0; p < one.cols(); ++p) {
+    bool differs = false;
+    for (Eigen::Index r = 0; r < 3; ++r) {
+      const double a = one(r, p), b = two(r, p);
+      if (std::memcmp(&a, &b, sizeof a) == 0) continue;
+      if (first < 0) first = p, row = r;
+      differs = true;
+    }
+    differing += differs ? 1 : 0;
+  }
+  check.passed = first < 0;
+  check.text = check.passed ? "the same bits in 3 x " + std::to_string(one.cols())
+                            : "particle " + std::to_string(first) + " differs first, at row " + std::to_string(row) +
+                                  ": one thread " + cl::test::digits(one(row, first)) + ", two threads " +
+                                  cl::test::digits(two(row, first)) + " (" + std::to_string(differing) + " of " +
+                                  std::to_string(one.cols()) + " particles differ)";
+  return check;
+}
+
 }  // namespace
 
 TEST_CASE("the sweep is the vertex updates in colour order and never raises g; pinned particles never move",
@@ -53,8 +85,7 @@ TEST_CASE("the sweep is the vertex updates in colour order and never raises g; p
       cl::lab12::vbd_sweep(c.problem, c.adjacency, c.groups, c.y, c.x);
       for (const std::vector<int>& group : c.groups) {
         for (const int p : group) {
-          serial.col(p) += cl::lab12::vertex_update(cl::lab12::vertex_block(c.problem, c.adjacency, serial, c.y, p),
-                                                    c.problem.inv_mass[p]);
+          serial.col(p) += cl::lab12::vertex_update(c.problem, c.adjacency, serial, c.y, p);
         }
       }
       CAPTURE(k, sweep);
@@ -81,7 +112,7 @@ TEST_CASE("the coloured sweep gives the same bits on one and two threads", "[lab
     for (int sweep = 0; sweep < 5; ++sweep) cl::lab12::vbd_sweep(start.problem, start.adjacency, start.groups, start.y, two);
     CAPTURE(k);
     REQUIRE(one != start.x);
-    REQUIRE(one == two);
+    REQUIRE(same_bits(one, two));
   }
   omp_set_num_threads(saved);
 }
