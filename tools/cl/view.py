@@ -123,7 +123,8 @@ html, body {{ margin: 0; height: 100%; overflow: hidden; background: #f4f4f0; fo
 #controls {{ position: absolute; left: 8px; right: 8px; bottom: 8px; display: flex; gap: 8px; align-items: center; }}
 #controls input[type=range] {{ flex: 1; }}
 #bar {{ position: absolute; right: 10px; bottom: 44px; width: 150px; text-align: center; font-size: 11px; }}
-#bar canvas {{ width: 150px; height: 12px; border: 1px solid #888; }}
+#bar canvas {{ width: 150px; height: 12px; border: 1px solid #888; box-sizing: border-box; }}
+#bar select {{ width: 100%; box-sizing: border-box; margin-top: 2px; font-size: 11px; }}
 </style></head>
 <body data-ready="0">
 <script>
@@ -136,7 +137,8 @@ window.addEventListener('error', function (e) {{ document.body.setAttribute('dat
 <div id="hud"></div>
 <div id="bar"><div id="bar-title">strain (l − L)/L</div><canvas id="bar-canvas" width="150" height="12"></canvas>
 <div><span id="bar-low" style="float:left"></span><span id="bar-high" style="float:right"></span>0</div>
-<select id="scale"><option value="run">scale: largest of the run(s)</option><option value="frame">scale: this frame's</option>
+<select id="scale" title="the colour scale: the largest |strain| of every frame, of the frame shown, or fixed">
+<option value="run">scale: all frames</option><option value="frame">scale: this frame</option>
 <option value="0.1">scale: 10 %</option><option value="0.01">scale: 1 %</option><option value="0.001">scale: 0.1 %</option></select></div>
 <div id="controls">
 <button id="back" title="previous frame (←)">&#9664;&#9646;</button>
@@ -170,13 +172,27 @@ def write_atomic(path, text):
         raise
 
 
+def comparison_name(first, second):
+    """The file of a side-by-side view: view-A-vs-B.html, A and B the runs' folder names."""
+    return f"view-{Path(first).name}-vs-{Path(second).name}.html"
+
+
+def default_output(folders):
+    """DIR/view.html for one run; for two, DIR's parent/view-A-vs-B.html, so that
+    a comparison never overwrites the first run's own view (./course demo names
+    its comparisons alike)."""
+    if len(folders) == 1:
+        return folders[0] / "view.html"
+    return folders[0].resolve().parent / comparison_name(*folders)
+
+
 def write_view(folders, output=None):
-    """Write the view of one run or two (folders) to `output` (default
-    FOLDER/view.html); return its path. Refuses (CourseError, exit 2) before
+    """Write the view of one run or two (folders) to `output` (default:
+    default_output); return its path. Refuses (CourseError, exit 2) before
     writing anything."""
     folders = [Path(f) for f in folders]
     runs = [load_run(f) for f in folders]
-    output = Path(output) if output else folders[0] / "view.html"
+    output = Path(output) if output else default_output(folders)
     title = " vs ".join(f"{h['lab']} {h['scene']} {h['method']}" for h, _ in runs)
     write_atomic(output, page(runs, title.replace("<", "&lt;")))
     return output
@@ -186,7 +202,8 @@ def cmd_view(argv):
     parser = argparse.ArgumentParser(prog="course view",
                                      description="a self-contained 3-D player of a run's frames (--frames N --out DIR)")
     parser.add_argument("dirs", nargs="+", metavar="DIR", help="a run's --out folder; a second one: side by side")
-    parser.add_argument("--output", help="the HTML file (default DIR/view.html)")
+    parser.add_argument("--output", help="the HTML file (default DIR/view.html; with DIR2 view-DIR-vs-DIR2.html "
+                                         "beside DIR)")
     args = parser.parse_args(argv)
     if len(args.dirs) > 2:
         raise refuse("view: one run or two (DIR [DIR2]), not " + str(len(args.dirs)))

@@ -250,8 +250,18 @@
     if (e.key === 'ArrowLeft') document.getElementById('back').onclick();
     if (e.key === 'ArrowRight') document.getElementById('forward').onclick();
   });
+  // The controls that pass (or touch) the window's edge, by id, in
+  // data-outside: a layout that works at one width can clip at another (the
+  // scale selector once ran to the right edge at 1200 px). The browser check reads it.
+  function markOutside() {
+    var outside = ['hud', 'bar', 'scale', 'controls', 'speed', 'loop'].filter(function (id) {
+      var box = document.getElementById(id).getBoundingClientRect();
+      return box.left < 2 || box.top < 2 || box.right > window.innerWidth - 2 || box.bottom > window.innerHeight - 2;
+    });
+    body.setAttribute('data-outside', outside.join(','));
+  }
   controls.addEventListener('change', draw);
-  window.addEventListener('resize', draw);
+  window.addEventListener('resize', function () { draw(); markOutside(); });
 
   function list(f) { return runs.map(f).join(','); }
   body.setAttribute('data-runs', String(runs.length));
@@ -259,6 +269,7 @@
   body.setAttribute('data-particles', list(function (run) { return run.header.particles; }));
   body.setAttribute('data-springs', list(function (run) { return run.header.springs.length / 2; }));
   show(shown);
+  markOutside();
   // ms from the start of the page's navigation to its first frame drawn (the load-time benchmark).
   body.setAttribute('data-ready-ms', String(Math.round(performance.now())));
   body.setAttribute('data-ready', '1');
