@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -12,7 +13,6 @@
 #include "accelerated.h"
 #include "common/health.h"
 #include "common/metrics.h"
-#include "common/output.h"
 #include "common/timer.h"
 
 namespace cl::lab12 {
@@ -293,6 +293,17 @@ std::string kind_of(const std::string& problem) {
   return kind;
 }
 
+// A grid value as the handout writes it: 1e8, 1e-4, 0.1, 0.5.
+std::string table_number(double value) {
+  const int exponent = static_cast<int>(std::lround(std::log10(value)));
+  if (std::abs(value - std::pow(10.0, exponent)) <= 1e-12 * value && (exponent < -1 || exponent > 1)) {
+    return "1e" + std::to_string(exponent);
+  }
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
 }  // namespace
 
 std::vector<StabilityCell> stability_cells(const Scene& scene, Method method, const Settings& settings) {
@@ -316,13 +327,13 @@ std::vector<StabilityCell> stability_cells(const Scene& scene, Method method, co
 std::string stability_markdown(const std::vector<StabilityCell>& cells) {
   std::ostringstream text;
   text << "| k (N/m) \\ Δt (s) |";
-  for (const double dt : kTableDt) text << " " << format_double(dt) << " |";
+  for (const double dt : kTableDt) text << " " << table_number(dt) << " |";
   text << "\n|---|";
   for (std::size_t c = 0; c < kTableDt.size(); ++c) text << "---|";
   std::map<std::string, int> kinds;
   std::size_t next = 0;
   for (const double stiffness : kTableStiffness) {
-    text << "\n| " << format_double(stiffness) << " |";
+    text << "\n| " << table_number(stiffness) << " |";
     for (std::size_t c = 0; c < kTableDt.size(); ++c) {
       for (std::size_t k = 0; k < kTableIterations.size() && next < cells.size(); ++k, ++next) {
         const RunResult& result = cells[next].result;

@@ -6,6 +6,7 @@
 //                  convergence.csv (objective_error = (g − g*)/g*, g* lab 06's
 //                  Newton minimum, per sweep) and a table of the sweeps and
 //                  seconds to each target
+//   --stability    experiment 2: the table of k × Δt × K on the scene (stability.csv)
 #include <omp.h>
 
 #include <cmath>
@@ -31,7 +32,7 @@ struct LabOptions {
   bool estimate = true;  // no --rho: measure it on the scene
   int estimate_iterations = 400;
   int threads = 1;
-  bool convergence = false;
+  bool convergence = false, stability = false;
   std::vector<std::string> sweep_scenes;
 };
 
@@ -81,15 +82,11 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   if (!options.summary.empty()) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
-    summary.extra["init"] = lab.init;
-    summary.extra["colours"] = solver.colour_count();
-    summary.extra["max_strain"] = strain.max;
-    summary.extra["threads"] = lab.threads;
-    summary.extra["rho"] = settings.rho;
-    summary.extra["rho_estimated"] = lab.estimate && method == Method::kVbdChebyshev;
-    summary.extra["tolerance"] = settings.tolerance;
-    summary.extra["restarts"] = result.restarts;
-    summary.extra["iterations_done"] = result.iterations_done;
+    summary.extra.update({{"init", lab.init}, {"colours", solver.colour_count()}, {"max_strain", strain.max},
+                          {"threads", lab.threads}, {"rho", settings.rho},
+                          {"rho_estimated", lab.estimate && method == Method::kVbdChebyshev},
+                          {"tolerance", settings.tolerance}, {"restarts", result.restarts},
+                          {"iterations_done", result.iterations_done}});
     cl::add_divergence(summary, result.problem, "diverged_at_step", result.problem_step);
     cl::write_summary(options.summary, summary);
   }
@@ -152,6 +149,18 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   return 0;
 }
 
+int run_stability(const cl::CommonOptions& options, const LabOptions& lab) {
+  cl::refuse_run_flags(options, "", "--stability writes stability.csv, not a run summary");
+  const Method method = cl::lab12::method_from_name(options.method);
+  if (method == Method::kVbdChebyshev && lab.estimate) throw cl::InputError("--stability: vbd-chebyshev needs --rho");
+  const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  const std::vector<cl::lab12::StabilityCell> cells = cl::lab12::stability_cells(scene, method, lab.settings);
+  std::printf("%s", cl::lab12::stability_markdown(cells).c_str());
+  if (!options.out.empty()) cl::lab12::stability_csv(cells).write(cl::join_path(options.out, "stability.csv"));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -175,14 +184,17 @@ int main(int argc, char** argv) {
   app.add_option("--estimate-iterations", lab.estimate_iterations, "plain sweeps that estimate rho (no --rho)")
       .range(2, 1'000'000).capture_default_str().only_for_methods({"vbd-chebyshev"});
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
+  app.add_flag("--stability", lab.stability, "experiment 2: every k, dt and K of the table on --scene (stability.csv)");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
-    if (lab.convergence) cl::refuse_run_flags(options, "only for a run of steps", "");
+    if (lab.convergence && lab.stability) throw cl::InputError("--stability: not with --convergence");
+    if (lab.convergence || lab.stability) cl::refuse_run_flags(options, "only for a run of steps", "");
     lab.settings.init = cl::lab12::init_from_name(lab.init);
     omp_set_num_threads(lab.threads);
+    if (lab.stability) return run_stability(options, lab);
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
 }
