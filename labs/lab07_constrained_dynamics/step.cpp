@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <new>
 #include <stdexcept>
 #include <string>
 
@@ -89,18 +90,37 @@ StepResult constrained_step(Particles& particles, const std::vector<Spring>& spr
   return constrained_step(particles, springs, make_movable_map(particles.inv_mass), settings);
 }
 
+std::string out_of_memory_problem(Method method, Eigen::Index unknowns, Eigen::Index constraints) {
+  const std::string sizes = std::to_string(unknowns) + " velocity unknowns, " + std::to_string(constraints) +
+                            " constraints";
+  if (method == Method::kKkt) {
+    const std::string side = std::to_string(unknowns + constraints);
+    return "out of memory in the KKT solve: its matrix is " + side + " x " + side + " (" + sizes +
+           ") and its factorization fills in far beyond that; try a smaller scene, or --method schur (a " +
+           std::to_string(constraints) + " x " + std::to_string(constraints) + " system)";
+  }
+  return "out of memory in the Schur solve: its matrix dt^2 J W J^T + C is " + std::to_string(constraints) + " x " +
+         std::to_string(constraints) + " (" + sizes + "); try a smaller scene (fewer springs)";
+}
+
 StepResult constrained_step(Particles& particles, const std::vector<Spring>& springs, const MovableMap& map,
                             const StepSettings& settings) {
-  const LinearizedStep step = linearize(particles, springs, map, settings);
   StepSolution solution;
-  if (settings.method == Method::kKkt) {
-    solution = solve_kkt(kkt_system(step), step.velocity.size());
-  } else {
-    solution = solve_schur(step);
+  Eigen::Index unknowns = 0;
+  try {
+    const LinearizedStep step = linearize(particles, springs, map, settings);
+    unknowns = step.velocity.size();
+    if (settings.method == Method::kKkt) {
+      solution = solve_kkt(kkt_system(step), unknowns);
+    } else {
+      solution = solve_schur(step);
+    }
+  } catch (const std::bad_alloc&) {
+    throw std::runtime_error(out_of_memory_problem(settings.method, 3 * static_cast<Eigen::Index>(map.unknowns()),
+                                                   static_cast<Eigen::Index>(springs.size())));
   }
   StepResult result;
-  result.problem =
-      solution_problem(solution, step.velocity.size(), static_cast<Eigen::Index>(springs.size()));
+  result.problem = solution_problem(solution, unknowns, static_cast<Eigen::Index>(springs.size()));
   if (!result.problem.empty()) return result;
   result.ok = true;
   update_positions(particles, map, solution.velocity, settings.dt);

@@ -50,7 +50,9 @@ struct StepResult {
 // solve_schur (Method::kSchur), then update_positions. When the solve fails
 // (a singular system) the particles are left exactly as they were and the
 // result says why. Throws std::invalid_argument for invalid settings or a
-// state whose sizes disagree.
+// state whose sizes disagree, and std::runtime_error with
+// out_of_memory_problem's line when memory runs out (instead of a bare
+// std::bad_alloc, which names neither the matrix nor a way out).
 StepResult constrained_step(Particles& particles, const std::vector<Spring>& springs, const StepSettings& settings);
 
 // The same with a map built once by the caller (make_movable_map of the
@@ -64,6 +66,13 @@ StepResult constrained_step(Particles& particles, const std::vector<Spring>& spr
 // v_new or λ of the wrong size, or non-finite ones. Lab 09's step judges its
 // solves with it too.
 std::string solution_problem(const StepSolution& solution, Eigen::Index unknowns, Eigen::Index constraints);
+
+// The line for a step whose memory ran out while it assembled or factored
+// its system of `unknowns` velocity entries (3 per movable particle) and
+// `constraints` rows: what ran out, the matrix of the method and its size,
+// and what to try (a smaller scene; for the KKT solve, the Schur solve, whose
+// matrix has one row per constraint only).
+std::string out_of_memory_problem(Method method, Eigen::Index unknowns, Eigen::Index constraints);
 
 // max_e |φ_e| (m), 0 without springs.
 double max_constraint_error(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs);
