@@ -46,6 +46,11 @@ TEST_CASE("convergence measures the force imbalance and the constraint error", "
   heavy[1] = -8.0;
   const cl::lab13::Convergence h = cl::lab13::convergence(residuals_of(heavy, force, constraint), 1.0, 1.0);
   CHECK(near(h.force_error, 4.0 / 8.0, 1e-15, "force error = 4 N / 8 N"));
+  // … or the constraint force (10 N), when it is the larger.
+  Eigen::VectorXd pulled = force;
+  pulled[2] = 10.0;  // imbalance 9.5 N at entry 2
+  const cl::lab13::Convergence f = cl::lab13::convergence(residuals_of(inertia, pulled, constraint), 1.0, 1.0);
+  CHECK(near(f.force_error, 9.5 / 10.0, 1e-15, "force error = 9.5 N / 10 N (the scale is the larger force, J^T lambda)"));
 }
 
 TEST_CASE("convergence is zero at rest and with nothing to balance", "[lab13][pts=1]") {
