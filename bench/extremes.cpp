@@ -1,5 +1,5 @@
 // The extremes matrix (issue 12, docs/DESIGN.md §6): every solver of labs
-// 04-10 × stiffness × Δt × mass ratio × geometry × iteration count on a small
+// 04-13 × stiffness × Δt × mass ratio × geometry × iteration count on a small
 // curtain. Each cell ends one of four ways:
 //   finite          every step done, the state finite and bounded;
 //   reported        the program said it went wrong: the step reported a
@@ -300,7 +300,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", options.out, "folder for the CSV files").capture_default_str();
   app.add_option("--methods", options.methods,
                  "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles, "
-                 "pd-chebyshev, pd-lbfgs, jacobi-chebyshev, vbd, vbd-chebyshev")
+                 "pd-chebyshev, pd-lbfgs, jacobi-chebyshev, vbd, vbd-chebyshev, constrained-newton, "
+                 "constrained-newton-drop")
       .delimiter(',');
   app.add_option("--steps", options.steps, "steps per cell (default 120, quick 8)").range(1, 1'000'000);
   app.add_option("--long-steps", options.long_steps, "steps of the 10,000-iteration cells (default 12, quick 2)")

@@ -17,6 +17,7 @@
 #include "labs/lab10_hierarchical_pbd/simulation.h"
 #include "labs/lab11_acceleration/accelerated.h"
 #include "labs/lab12_vertex_block_descent/descent.h"
+#include "labs/lab13_constrained_newton/iteration.h"
 
 namespace cl::bench {
 
@@ -48,6 +49,8 @@ const std::vector<MethodInfo>& all_methods() {
       {"jacobi-chebyshev", "lab11", Family::kHard, true, false},
       {"vbd", "lab12", Family::kImplicitEuler, true, false},
       {"vbd-chebyshev", "lab12", Family::kImplicitEuler, true, false},
+      {"constrained-newton", "lab13", Family::kImplicitEuler, true, false},
+      {"constrained-newton-drop", "lab13", Family::kImplicitEuler, true, false},
   };
   return methods;
 }
@@ -300,6 +303,42 @@ class VbdStepper : public Stepper {
   lab12::Settings settings_;
 };
 
+// Lab 13: Newton on the constrained system (x and λ), from the start's
+// positions with λ⁰ the forces the springs carry (the previous step's λ for
+// a hard spring, kept by the solver between steps, as the lab's loop keeps
+// it). Tolerance 0: K iterations, as the other iterative methods run; the
+// step ends earlier only at ψ = 0 or when no step length lowers the merit
+// (round-off), which the trade reads as "stopped before K", as Newton's.
+// Compressed springs in K_g: kept (the lab's default, the exact Jacobian,
+// with lab 07's KKT solve when the Schur matrix is not definite) for
+// constrained-newton, dropped for constrained-newton-drop.
+class ConstrainedNewtonStepper : public Stepper {
+ public:
+  ConstrainedNewtonStepper(const Scene& scene, int iterations, lab09::Compression compression)
+      : solver_(scene.particles.inv_mass, scene.springs, scene.dt) {
+    settings_.gravity = scene.gravity;
+    settings_.iterations = iterations;
+    settings_.tolerance = 0.0;
+    settings_.start = lab13::Start::kPositions;
+    settings_.warm = lab13::Warm::kForces;
+    settings_.compression = compression;
+  }
+  StepOutcome step(Particles& particles) override {
+    const SpdBackendCounts before = spd_backend_counts();
+    const lab13::StepReport report = solver_.step(particles, settings_);
+    // Lab 09's primal (Schur) solve when every c_e > 0, with lab 07's KKT
+    // solve for an iteration whose matrix is not definite; the KKT solve (LU)
+    // when some spring is hard.
+    std::string solver = report.linear_solver == "kkt" ? std::string("sparse-lu") : backends_since(before);
+    if (report.linear_solver != "kkt" && report.fallbacks > 0) solver += "+kkt";
+    return {report.problem, report.iterations_done, solver};
+  }
+
+ private:
+  lab13::Solver solver_;
+  lab13::Settings settings_;
+};
+
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations) {
@@ -318,6 +357,12 @@ std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& sc
   if (name == "pd-lbfgs") return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kPdLbfgs);
   if (name == "vbd") return std::make_unique<VbdStepper>(scene, iterations, lab12::Method::kVbd);
   if (name == "vbd-chebyshev") return std::make_unique<VbdStepper>(scene, iterations, lab12::Method::kVbdChebyshev);
+  if (name == "constrained-newton") {
+    return std::make_unique<ConstrainedNewtonStepper>(scene, iterations, lab09::Compression::kKeep);
+  }
+  if (name == "constrained-newton-drop") {
+    return std::make_unique<ConstrainedNewtonStepper>(scene, iterations, lab09::Compression::kDrop);
+  }
   if (name == "jacobi-chebyshev") {
     return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kJacobiChebyshev);
   }

@@ -1,5 +1,5 @@
 #pragma once
-// The step of every solver of labs 04-10 behind one interface, for the two
+// The step of every solver of labs 04-13 behind one interface, for the two
 // cross-lab programs (trade.cpp: the speed/accuracy trade; extremes.cpp: the
 // stability matrix). Each wraps a lab's REFERENCE code and keeps what that
 // lab's own loop keeps between steps (XPBD's multipliers, lab 09's previous
@@ -18,7 +18,9 @@ namespace cl::bench {
 
 // What a method's step converges to (bench/README.md, "Which problem"):
 //   hard           PBD (GS, Jacobi, hierarchical): every spring a hard constraint;
-//   implicit-euler PD, Newton and XPBD: implicit Euler with spring energy ½ k φ²;
+//   implicit-euler PD, Newton, XPBD (and labs 11-13's): implicit Euler with
+//                  spring energy ½ k φ² (lab 13's constrained Newton: for
+//                  finite k; with hard springs it converges to the hard step);
 //   linearized     KKT, Schur, Schur with geometric stiffness (lab 09): one
 //                  solve of implicit Euler with the constraints linearised;
 //   limited        lab 05: explicit springs and a strain limiter.
@@ -35,7 +37,9 @@ struct MethodInfo {
 
 // Every method, in the order of the tables: gs-pbd, jacobi-pbd, hpbd, xpbd,
 // pd, newton, kkt, schur, schur-kg, limit-springs, limit-triangles,
-// pd-chebyshev, pd-lbfgs, jacobi-chebyshev (lab 11), vbd, vbd-chebyshev (lab 12).
+// pd-chebyshev, pd-lbfgs, jacobi-chebyshev (lab 11), vbd, vbd-chebyshev (lab 12),
+// constrained-newton, constrained-newton-drop (lab 13: compressed springs
+// kept in K_g, the lab's default, or dropped).
 const std::vector<MethodInfo>& all_methods();
 // Throws std::invalid_argument for an unknown name (the message lists them).
 const MethodInfo& method_info(const std::string& name);
@@ -59,7 +63,8 @@ class Stepper {
 // The method's solver for `scene`: its springs, triangles, grid, gravity and
 // dt; the current positions of scene.particles are the rest shape where the
 // method needs one (lab 10's hierarchy, lab 05's triangles). `iterations` is
-// K (sweeps per level for hpbd; the most iterations for newton).
+// K (sweeps per level for hpbd; the most iterations for newton and
+// constrained-newton).
 // Throws std::invalid_argument or cl::InputError, with the lab's message,
 // when the method does not take the scene (e.g. PD and a hard spring).
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations);
