@@ -8,7 +8,9 @@ with Chebyshev, L-BFGS, Newton on the same curtains; same columns), and writes
 in OUTDIR/lab12_vertex_block_descent/, per scene that lab 12 ran:
   convergence_<scene>.png  relative objective error (g - g*)/g* against
                            iteration (left) and wall time (right), log scales
-Exit 4 when lab 12's data are absent.
+Without lab 11's data for a scene the figure has lab 12's curves only, says so
+under its title, and the script says on stderr (the shared skip rule's form)
+which command makes them. Exit 4 when lab 12's data are absent.
 """
 import _figures as figures
 from _figures import plt
@@ -41,7 +43,14 @@ def read_runs(paths):
     return runs
 
 
-def draw(scene, curves, target):
+def lab11_hint(out_dir, scene):
+    """Where lab 11's curves for `scene` come from: its demo, or the line of it for this scene."""
+    return (f"PD, Chebyshev PD, L-BFGS and Newton need lab 11's run: ./course demo, or "
+            + figures.make_command(OTHER, f"--scene {scene} --convergence --method pd-chebyshev --iterations 3000 "
+                                   f"--out {out_dir / OTHER}/exp1/chebyshev") + " (and --method pd, pd-lbfgs, newton)")
+
+
+def draw(scene, curves, target, missing=None):
     figure, (by_iteration, by_time) = plt.subplots(1, 2, figsize=(12, 4.5))
     for name, found in sorted(curves.items()):
         error = [max(float(row["objective_error"]), FLOOR) for row in found]
@@ -57,7 +66,9 @@ def draw(scene, curves, target):
     figures.finish(by_iteration, "iteration or sweep (0 drawn at 0.8)", "relative objective error (g - g*) / g* (1)")
     figures.finish(by_time, "wall time of the step (s)", "relative objective error (g - g*) / g* (1)")
     figure.suptitle(f"Lab 12: one implicit-Euler step of {scene}; g* = lab 06's Newton minimum")
-    figure.tight_layout()
+    if missing:
+        figure.text(0.5, 0.90, missing, ha="center", fontsize=7, color="tab:red")
+    figure.tight_layout(rect=(0, 0, 1, 0.9 if missing else 1))
     figures.save(figure, target, dpi=120)
 
 
@@ -76,7 +87,13 @@ def main(out_dir):
         target = lab_dir / f"convergence_{scene}.png"
         if figures.up_to_date(target, tables + others):
             continue
-        draw(scene, {**theirs.get(scene, {}), **curves}, target)
+        missing = None
+        if not theirs.get(scene):
+            figures.skip("lab12_convergence", f"{target.name}: no lab 11 curves for {scene}; "
+                         + lab11_hint(out_dir, scene))
+            missing = (f"No PD, Chebyshev PD, L-BFGS or Newton curve: they come from lab 11's run of {scene} "
+                       "(./course demo, or the --convergence lines of labs/lab11_acceleration/demo.txt)")
+        draw(scene, {**theirs.get(scene, {}), **curves}, target, missing)
     return 0
 
 
