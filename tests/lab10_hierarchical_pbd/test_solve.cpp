@@ -1,5 +1,6 @@
 // Graded tests for lab10.3, solve_hierarchy: the order of the coarse-to-fine
-// pass, the start it measures corrections from, the masses of the coarse
+// pass (the cloth last, and among the coarse levels coarsest first), the
+// start it measures corrections from, the masses of the coarse
 // sweeps, the one-level case, and bad arguments. Each mistake of the pass has
 // a case that names it; all of them call the student's
 // project_unilateral_distance and prolong_corrections (lab10.1, lab10.2).
@@ -46,10 +47,15 @@ Matrix3Xd disturbed(const cl::Scene& scene, double scale, double noise, std::mt1
 // unilateral here), the prolongation formula and lab 02's sweeps: the
 // contract of solve_hierarchy, independent of the student's three functions.
 // Counts the coarse projections that found their constraint stretched and slack.
-Matrix3Xd written_pass(const cl::ClothHierarchy& hierarchy, const Matrix3Xd& start, const std::vector<int>& iterations,
-                       int& stretched, int& slack) {
-  Matrix3Xd x = start;
+// With from_level_start, each prolongation measures its corrections from the
+// start of its own level instead (not the contract: what the order's case
+// tolerates so that it judges the order alone).
+Matrix3Xd written_pass(const cl::ClothHierarchy& hierarchy, const Matrix3Xd& pass_start,
+                       const std::vector<int>& iterations, int& stretched, int& slack, bool from_level_start = false) {
+  Matrix3Xd x = pass_start;
+  Matrix3Xd start = pass_start;
   for (int l = hierarchy.level_count() - 1; l >= 1; --l) {
+    if (from_level_start) start = x;
     const cl::HierarchyLevel& level = hierarchy.levels[static_cast<std::size_t>(l)];
     for (int k = 0; k < iterations[static_cast<std::size_t>(l)]; ++k) {
       for (const cl::Spring& s : level.springs) {
@@ -119,7 +125,8 @@ void check_pass(const cl::ClothHierarchy& hierarchy, const cl::Scene& scene, con
 
 TEST_CASE("levels are solved coarsest first and the cloth last", "[lab10][pts=1]") {
   // Two levels with sweeps on both: the coarse sweeps and the prolongation
-  // come before the cloth's sweeps. (Every level has the cloth's masses here.)
+  // come before the cloth's sweeps. (Every level has the cloth's masses here,
+  // so the masses cannot matter.)
   std::mt19937_64 rng(1010);
   for (const auto& [nx, ny] : {std::pair<int, int>{9, 7}, {12, 12}}) {
     const cl::Scene scene = uneven_cloth(nx, ny, rng);
@@ -127,6 +134,35 @@ TEST_CASE("levels are solved coarsest first and the cloth last", "[lab10][pts=1]
         nx, ny, scene.particles.x, scene.particles.inv_mass, scene.springs, 2);
     same_masses_on_every_level(hierarchy);
     check_pass(hierarchy, scene, {2, 3}, rng);
+  }
+  // Three and four levels with sweeps on every one: among the coarse levels
+  // too the coarsest comes first (fine-to-coarse passes the two-level part).
+  // Which start the prolongations measure from is the next case's business:
+  // either start passes here, so a failure here is the order of the levels.
+  for (const auto& [n, levels] : {std::pair<int, int>{13, 3}, {17, 4}}) {
+    const cl::Scene scene = uneven_cloth(n, n, rng);
+    cl::ClothHierarchy hierarchy = cl::build_cloth_hierarchy(
+        n, n, scene.particles.x, scene.particles.inv_mass, scene.springs, levels);
+    REQUIRE(hierarchy.level_count() == levels);
+    same_masses_on_every_level(hierarchy);
+    std::vector<int> iterations(static_cast<std::size_t>(levels), 2);
+    iterations.back() = 3;
+    const Matrix3Xd start = disturbed(scene, 1.15, 0.06, rng);
+    int stretched = 0, slack = 0;
+    const Matrix3Xd from_pass = written_pass(hierarchy, start, iterations, stretched, slack);
+    const Matrix3Xd from_level = written_pass(hierarchy, start, iterations, stretched, slack, true);
+    Matrix3Xd x = start;
+    cl::lab10::solve_hierarchy(x, hierarchy, iterations);
+    const cl::test::Check pass = cl::test::near(x, from_pass, 1e-12, "particle");
+    const cl::test::Check level = cl::test::near(x, from_level, 1e-12, "particle");
+    cl::test::Check order;
+    order.passed = pass.passed || level.passed;
+    order.text = order.passed ? "the coarsest-first pass"
+                              : "not the coarsest-first pass (levels " + std::to_string(levels - 1) +
+                                    " … 1, then the cloth), whichever start the corrections are measured from: " +
+                                    pass.text;
+    CAPTURE(n, levels, iterations, level.text);
+    REQUIRE(order);
   }
 }
 
