@@ -267,6 +267,20 @@ def check_views(checks, out, labs):
                   else f"{show(index)}: {len(missing)} links do not resolve", missing[:5])
 
 
+# The house's own limits (docs/DESIGN.md §1): a lab's driver holds only its
+# flags, its dispatch and one run's report; a tools/cl module one concern.
+# Checked, because both crept past them unnoticed (issue 35: 201 and 523).
+HOUSE_LIMITS = [("labs/*/main.cpp", 200), ("tools/cl/*.py", 500)]
+
+
+def check_house_limits(checks):
+    """Every file of HOUSE_LIMITS within its number of lines."""
+    for pattern, limit in HOUSE_LIMITS:
+        over = [f"{show(path)}: {count} lines" for path in sorted(ROOT.glob(pattern))
+                if (count := len(path.read_text().splitlines())) > limit]
+        checks.record(not over, f"{pattern}: at most {limit} lines each", over)
+
+
 def cmd_test(argv):
     argparse.ArgumentParser(prog="course test").parse_args(argv)
     checks = Checks()
@@ -276,6 +290,7 @@ def cmd_test(argv):
     except CourseError as error:
         checks.record(False, str(error), error.details)
         return checks.finish()
+    check_house_limits(checks)
     labs = build_labs(checks, lab_dirs())
     check_ctest(checks)
     out = BUILD / "test-demo"
