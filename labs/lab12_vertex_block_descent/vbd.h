@@ -3,7 +3,8 @@
 // Derivation: labs/lab12_vertex_block_descent/README.md. Source: A. H. Chen,
 // Z. Liu, Y. Yang, C. Yuksel, "Vertex Block Descent", ACM TOG 43(4)
 // (SIGGRAPH 2024): the per-vertex local system, its guard, the graph
-// colouring and the parallel sweep.
+// colouring and the parallel sweep; the per-vertex backtracking is the one
+// in the authors' Gaia code, there compiled out by default (README.md).
 //
 // One implicit-Euler step of size Δt minimises lab 06's objective
 //     g(x) = Σ_{movable p} m_p ‖x_p − y_p‖² / (2Δt²) + Σ_e k_e/2 (‖x_i − x_j‖ − L_e)².
@@ -118,7 +119,8 @@ constexpr int kMaxHalvings = 60;
 // overshoot and raise g (three particles, README.md: 40.55 J to 79.78 J in
 // one sweep). α = 2^−j scales d exactly (a power of two), and the full step
 // (α = 1) is kept wherever it passes, as it does near the minimum. An update
-// therefore lowers g by at least c α f_iᵀ d, or is a no-op: never a rise.
+// therefore lowers g by at least c α f_iᵀ d, or is a no-op: never a rise
+// (beyond the round-off of g's own sum).
 // Returns the step Δx_i (m) to add to x_i; never NaN. Throws what
 // vertex_block throws.
 Eigen::Vector3d vertex_update(const lab06::Problem& problem, const Adjacency& adjacency, const Eigen::Matrix3Xd& x,
