@@ -22,14 +22,9 @@ struct Row {
 // expected false: g fell" — the answer and the reason, never Catch's
 // expansion of a negated call ("!true").
 cl::test::Check answers(const Row& row) {
-  cl::test::Check check;
-  const bool got = cl::lab11::restart_needed(row.before, row.after, row.slack);
-  check.passed = got == row.restart;
-  check.text = std::string("restart_needed(before ") + cl::test::digits(row.before) + ", after " +
-               cl::test::digits(row.after) + ", slack " + cl::test::digits(row.slack) + ") returned " +
-               (got ? "true" : "false") + (check.passed ? "" : std::string(", expected ") +
-               (row.restart ? "true" : "false")) + ": " + row.why;
-  return check;
+  const std::string call = "restart_needed(before " + cl::test::digits(row.before) + ", after " +
+                           cl::test::digits(row.after) + ", slack " + cl::test::digits(row.slack) + ")";
+  return cl::test::answer(call, cl::lab11::restart_needed(row.before, row.after, row.slack), row.restart, row.why);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 //   REQUIRE(cl::test::near(x, expected, 1e-12, "particle"));   // matrices: what a column is
 //   REQUIRE(cl::test::at_most("strain", strain, 1e-3));        // a one-sided bound
 //   REQUIRE(cl::test::solved(result));                         // result.ok, else result.problem
+//   CHECK(cl::test::answer("f(1)", f(1), false, "why"));        // a yes/no answer, with the call and why
 //
 // (Catch's WithinRel/WithinAbs print "X and Y are within ... of each other" on
 // a failure, which reads like a pass; these say the difference and the bound.)
@@ -120,6 +121,19 @@ inline Check at_least(const std::string& what, double value, double bound) {
   Check check;
   check.passed = value >= bound;
   check.text = what + " = " + digits(value) + (check.passed ? " >= " : " < ") + digits(bound);
+  return check;
+}
+
+// A yes/no function's answer: passes when `got` is `expected`; the text is
+// "CALL returned true, expected false: WHY" (on a pass "CALL returned false:
+// WHY"). For a predicate, so that a failure reads as the call, its answer and
+// the reason instead of Catch's expansion of REQUIRE_FALSE(f(...)), "!true".
+inline Check answer(const std::string& call, bool got, bool expected, const std::string& why) {
+  Check check;
+  check.passed = got == expected;
+  check.text = call + " returned " + (got ? "true" : "false") +
+               (check.passed ? std::string() : std::string(", expected ") + (expected ? "true" : "false")) + ": " +
+               why;
   return check;
 }
 
