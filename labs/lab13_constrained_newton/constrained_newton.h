@@ -56,7 +56,7 @@ struct Residuals {
 // constraint_jacobian (coincident ends: an empty row of J, never NaN).
 // Throws std::invalid_argument when x, y, inv_mass or map do not have one
 // entry per particle, lambda does not have one per spring, compliance is
-// neither empty nor one per spring, or dt is not finite and > 0.
+// neither empty nor one per spring, or a dt that is NaN, infinite or ≤ 0.
 Residuals residuals(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const Eigen::VectorXd& lambda,
                     const std::vector<Spring>& springs, const Eigen::VectorXd& inv_mass, const MovableMap& map,
                     const Eigen::VectorXd& compliance, double dt);
@@ -66,8 +66,8 @@ Residuals residuals(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
 //     v̂ = (y − x)/Δt − Δt g,   so that   M(v̂ + Δt g) = M(y − x)/Δt,
 // the Newton right-hand side's first row times Δt. At x = x_old it is the
 // particles' own velocity, and the iteration's first step is lab 09's step.
-// Throws std::invalid_argument when x, y or map disagree in size, or dt is
-// not finite and > 0.
+// Throws std::invalid_argument when x, y or map disagree in size, or for a
+// dt that is NaN, infinite or ≤ 0.
 Eigen::VectorXd rebased_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const MovableMap& map,
                                  const Eigen::Vector3d& gravity, double dt);
 
@@ -103,9 +103,9 @@ struct Convergence {
 // TODO(lab13.4) — the convergence test above. length_scale (m, > 0): the
 // given code passes the springs' mean rest length (iteration.h). With no
 // unknowns the force error is 0; with no springs the constraint error is 0.
-// Throws std::invalid_argument for a length_scale or tolerance that is not
-// finite and > 0 (tolerance ≥ 0), or residuals whose force, inertia and
-// constraint_force sizes disagree.
+// Throws std::invalid_argument for a length_scale that is NaN, infinite or
+// ≤ 0, a tolerance that is NaN, infinite or < 0, or residuals whose force,
+// inertia and constraint_force sizes disagree.
 Convergence convergence(const Residuals& residuals, double length_scale, double tolerance);
 
 // TODO(lab13.5) — the merit's weights per spring (N/m):
@@ -113,8 +113,8 @@ Convergence convergence(const Residuals& residuals, double length_scale, double 
 // with w the inverse masses (a pinned end has w = 0) and c_e = compliance[e]
 // (0 for every spring when compliance is empty). A spring whose denominator
 // is 0 (hard, both ends pinned: nothing can change its φ) gets D_e = 0.
-// Throws std::invalid_argument for sizes that disagree, dt not finite and
-// > 0, or a spring index out of range.
+// Throws std::invalid_argument for sizes that disagree, a dt that is NaN,
+// infinite or ≤ 0, or a spring index out of range.
 Eigen::VectorXd merit_weights(const std::vector<Spring>& springs, const Eigen::VectorXd& inv_mass,
                               const Eigen::VectorXd& compliance, double dt);
 
@@ -123,7 +123,8 @@ Eigen::VectorXd merit_weights(const std::vector<Spring>& springs, const Eigen::V
 // w_k the inverse mass of the unknown that stacked entry k belongs to
 // (map.particle_of[k / 3]). ψ ≥ 0, and 0 exactly at the step. Each term is
 // an energy: Δt² w r_x² is (s²/kg) N² = J, D r_λ² is (N/m) m² = J. Throws
-// std::invalid_argument for sizes that disagree or dt not finite and > 0.
+// std::invalid_argument for sizes that disagree or a dt that is NaN, infinite
+// or ≤ 0.
 double merit(const Residuals& residuals, const Eigen::VectorXd& inv_mass, const MovableMap& map,
              const Eigen::VectorXd& weights, double dt);
 

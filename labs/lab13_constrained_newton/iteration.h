@@ -77,8 +77,8 @@ double length_scale(const std::vector<Spring>& springs);
 // make the KKT matrix singular): springs() and every λ are over the others.
 class Solver {
  public:
-  // Throws std::invalid_argument for dt not finite and > 0, a spring index out
-  // of range, or springs that lab 07's compliance_of refuses.
+  // Throws std::invalid_argument for a dt that is NaN, infinite or ≤ 0, a
+  // spring index out of range, or springs that lab 07's compliance_of refuses.
   Solver(const Eigen::VectorXd& inv_mass, const std::vector<Spring>& springs, double dt);
 
   // One step: y = lab06::predict, x⁰ (settings.start), λ⁰ = warm_start(x_old,
