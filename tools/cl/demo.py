@@ -15,7 +15,7 @@ from .base import ROOT, CourseError, show, under_root
 from .build import BuildFailure, build_targets, configure
 from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
 from .plots import plots_failed, run_plots
-from .view import write_view
+from .view import comparison_name, write_view
 
 
 def run_demos(out, echo=True, labs=None, student_fallback=True):
@@ -51,11 +51,6 @@ def run_demos(out, echo=True, labs=None, student_fallback=True):
             if done.returncode != 0:
                 raise CourseError(f"{shown} exited with code {done.returncode}",
                                   details=done.stderr.splitlines())
-
-
-def comparison_name(first, second):
-    """The file of a `view:` comparison, in its lab's output folder."""
-    return f"view-{Path(first).name}-vs-{Path(second).name}.html"
 
 
 def write_views(out, labs=None, echo=True):
