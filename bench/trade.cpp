@@ -127,6 +127,7 @@ struct Run {
   int iterations = 0, iterations_done = 0, repeats = 0, horizon_steps = 0;
   double step_seconds = 0, setup_seconds = 0;
   double max_strain = 0, rms_strain = 0, distance = 0, distance_max = 0, relative_distance = 0;
+  double relative_distance_hard = 0;  // to the hard step (NaN when it could not be computed)
   double energy_drift = 0, energy_drift_rel = 0;
   std::string problem;  // the step or the horizon went wrong (the run's numbers are then partial)
   bool on_front = false;
@@ -136,7 +137,9 @@ struct SceneInfo {
   std::string name;
   long long particles = 0, springs = 0;
   double reference_seconds = 0, reference_strain = 0, displacement = 0, energy_scale = 0;
-  int reference_constrained_iterations = 0, reference_iterations = 0;
+  int reference_constrained_iterations = 0, reference_iterations = 0, hard_iterations = 0;
+  double hard_force_error = 0.0, hard_constraint_error = 0.0, hard_max_strain = 0.0, hard_seconds = 0.0;
+  double hard_displacement = 0.0;  // RMS of the hard step's displacement, m (0: no hard step)
   double reference_constrained_gradient = 0.0, reference_gradient = 0.0;
 };
 
@@ -195,6 +198,7 @@ std::string time_text(double seconds) {
 struct Reference {
   cl::Particles after;
   int constrained_iterations = 0;  // lab 13's, -1 when PD started the polish
+  Eigen::VectorXd lambda;          // lab 13's multipliers at its last iterate (empty when PD started)
   int newton_iterations = 0;
   double constrained_gradient_norm = 0.0;  // ‖∇g‖∞ after lab 13's iterations, N
   double gradient_norm = 0.0;  // ‖∇g‖∞ at the result, N
@@ -224,6 +228,7 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
           return gradient <= 1e-9;
         });
     ref.constrained_iterations = report.iterations_done;
+    if (report.problem.empty()) ref.lambda = lambda;
     if (!report.problem.empty()) {
       std::unique_ptr<cl::bench::Stepper> pd = cl::bench::make_stepper("pd", scene, 500);
       const cl::bench::StepOutcome outcome = pd->step(ref.after);
@@ -296,6 +301,67 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
   ref.after.x = x;
   ref.seconds = timer.seconds();
   return ref;
+}
+
+// The hard family's own step, beside the k step: the M-norm projection of the
+// prediction onto the constraints. With C = 0 the curtains' structural and
+// shear springs are a redundant set (lab 07's KKT matrix is singular there,
+// lab 13 reports it), so the step is taken at k = 1e9 N/m (C = 1e-9 m/N), a
+// thousand times the scene's k: its strain, of order m g / k, is 1e-3 of the
+// k step's. Lab 13's constrained Newton from the k step's x and λ, compressed
+// springs kept (dropped, or at k = 1e10 N/m and more, it stalls on 32² and
+// 64²), until its constraint error (max |φ + Cλ| over the mean rest length)
+// is ≤ 1e-12 and its force error ≤ 1e-9; not converged within 30 iterations
+// or 60 s, the scene has no hard step (relative_distance_hard NaN).
+constexpr double kHardStiffness = 1e9;  // N/m
+
+struct HardStep {
+  Eigen::Matrix3Xd x;  // empty when it failed
+  int iterations = 0;
+  double force_error = 0.0, constraint_error = 0.0, max_strain = 0.0, seconds = 0.0;
+  std::string problem;
+};
+
+HardStep hard_step(const cl::Scene& scene, const cl::Particles& start, const Reference& reference) {
+  const cl::Timer timer;
+  HardStep hard;
+  if (reference.lambda.size() == 0) {
+    hard.problem = "no multipliers from the k step";
+    return hard;
+  }
+  std::vector<cl::Spring> springs = scene.springs;
+  for (cl::Spring& spring : springs) spring.stiffness = kHardStiffness;
+  const cl::lab13::Solver solver(scene.particles.inv_mass, springs, scene.dt);
+  cl::lab13::Settings settings;
+  settings.gravity = scene.gravity;
+  settings.iterations = 30;
+  settings.tolerance = 0.0;
+  settings.compression = cl::lab09::Compression::kKeep;
+  const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
+  Eigen::Matrix3Xd x = reference.after.x;
+  Eigen::VectorXd lambda = reference.lambda;
+  bool converged = false;
+  const cl::lab13::StepReport report =
+      solver.iterate(x, lambda, y, settings, [&](const cl::lab13::IterationRecord& record) {
+        converged = record.constraint_error <= 1e-12 && record.force_error <= 1e-9;
+        return converged || record.seconds > 60.0;
+      });
+  hard.iterations = report.iterations_done;
+  hard.force_error = report.force_error;
+  hard.constraint_error = report.constraint_error;
+  hard.problem = report.problem;
+  if (hard.problem.empty() && !converged) {
+    char text[160];
+    std::snprintf(text, sizeof text, "not converged after %d iterations (force error %.1e, constraint error %.1e)",
+                  report.iterations_done, report.force_error, report.constraint_error);
+    hard.problem = text;
+  }
+  if (hard.problem.empty()) {
+    hard.x = x;
+    hard.max_strain = cl::strain_stats(x, scene.springs).max;
+  }
+  hard.seconds = timer.seconds();
+  return hard;
 }
 
 // Marks the runs of one scene on the Pareto front of (step time, max strain
@@ -375,6 +441,13 @@ int run(const Options& options) {
     info.reference_strain = cl::strain_stats(converged.x, scene.springs).max;
     info.displacement = rms_distance(converged.x, start.x);
     info.energy_scale = cl::energy_scale(start, scene.gravity, scene.dt);
+    const HardStep hard = hard_step(scene, start, reference);
+    info.hard_iterations = hard.iterations;
+    info.hard_force_error = hard.force_error;
+    info.hard_constraint_error = hard.constraint_error;
+    info.hard_max_strain = hard.max_strain;
+    info.hard_seconds = hard.seconds;
+    if (hard.x.cols() == start.x.cols()) info.hard_displacement = rms_distance(hard.x, start.x);
     infos.push_back(info);
     progress.clear();
     std::printf("%-12s warm-up and reference step (constrained newton %d iterations to |grad g| %.1e N, newton %d to "
@@ -382,6 +455,14 @@ int run(const Options& options) {
                 scene.name.c_str(), info.reference_constrained_iterations, info.reference_constrained_gradient,
                 info.reference_iterations, info.reference_gradient, time_text(info.reference_seconds).c_str(),
                 warmup_timer.seconds());
+    if (info.hard_displacement > 0.0) {
+      std::printf("%-12s hard step (k = %.0e N/m, constrained newton %d iterations, force error %.1e, constraint "
+                  "error %.1e, %s)\n",
+                  scene.name.c_str(), kHardStiffness, info.hard_iterations, info.hard_force_error, info.hard_constraint_error,
+                  time_text(info.hard_seconds).c_str());
+    } else {
+      std::printf("%-12s hard step not computed: %s\n", scene.name.c_str(), hard.problem.c_str());
+    }
     std::fflush(stdout);
 
     const std::size_t first_run = runs.size();
@@ -430,6 +511,9 @@ int run(const Options& options) {
         r.distance = rms_distance(one.x, converged.x);
         r.distance_max = (one.x - converged.x).colwise().norm().maxCoeff();
         r.relative_distance = info.displacement > 0.0 ? r.distance / info.displacement : 0.0;
+        r.relative_distance_hard = info.hard_displacement > 0.0
+                                       ? rms_distance(one.x, hard.x) / info.hard_displacement
+                                       : std::numeric_limits<double>::quiet_NaN();
 
         // The horizon: `horizon` steps from the shared start with one solver.
         if (r.problem.empty()) {
@@ -468,7 +552,7 @@ int run(const Options& options) {
   // ---------------------------------------------------------------- output
   cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
                       "step_seconds", "seconds_per_iteration", "repeats", "setup_seconds", "max_strain", "rms_strain",
-                      "distance_rms", "distance_max", "relative_distance", "horizon_steps", "energy_drift",
+                      "distance_rms", "distance_max", "relative_distance", "relative_distance_hard", "horizon_steps", "energy_drift",
                       "energy_drift_rel", "on_front", "problem"});
   auto info_of = [&](const std::string& name) -> const SceneInfo& {
     return *std::find_if(infos.begin(), infos.end(), [&](const SceneInfo& i) { return i.name == name; });
@@ -479,7 +563,7 @@ int run(const Options& options) {
     table.add_row({r.scene, info.particles, info.springs, r.method, std::string(cl::bench::family_name(method.family)),
                    method.lab, r.linear_solver, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
                    r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
-                   r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance,
+                   r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance, r.relative_distance_hard,
                    static_cast<long long>(r.horizon_steps), r.energy_drift, r.energy_drift_rel,
                    static_cast<long long>(r.on_front ? 1 : 0), csv_text(r.problem)});
   }
@@ -487,27 +571,36 @@ int run(const Options& options) {
 
   cl::CsvTable scene_table({"scene", "particles", "springs", "stiffness", "dt", "warmup_steps", "reference_constrained_newton_iterations",
                             "reference_constrained_gradient_norm", "reference_newton_iterations", "reference_gradient_norm",
-                            "reference_seconds", "reference_max_strain", "step_displacement_rms", "energy_scale"});
+                            "reference_seconds", "reference_max_strain", "step_displacement_rms", "energy_scale",
+                            "hard_iterations", "hard_force_error", "hard_constraint_error", "hard_max_strain",
+                            "hard_seconds", "hard_displacement_rms"});
   for (const SceneInfo& info : infos) {
     scene_table.add_row({info.name, info.particles, info.springs, options.stiffness, 1.0 / 60.0,
                          static_cast<long long>(warmup), static_cast<long long>(info.reference_constrained_iterations),
                          info.reference_constrained_gradient, static_cast<long long>(info.reference_iterations),
                          info.reference_gradient,
-                         info.reference_seconds, info.reference_strain, info.displacement, info.energy_scale});
+                         info.reference_seconds, info.reference_strain, info.displacement, info.energy_scale,
+                         static_cast<long long>(info.hard_iterations), info.hard_force_error, info.hard_constraint_error,
+                         info.hard_max_strain, info.hard_seconds, info.hard_displacement});
   }
   scene_table.write(cl::join_path(options.out, "trade_scenes.csv"));
 
   // The fastest run to each target, per scene: of the max strain error (the
   // issue's table) and of the distance to the reference step relative to the
-  // step's displacement (which a method can only reach by solving the step).
+  // step's displacement (which a method can only reach by solving the step),
+  // and of the distance to the hard step (the hard family's own target; NaN,
+  // never a winner, when the scene has none).
   const std::vector<double> targets{1e-2, 1e-3};
-  const char* const measures[2] = {"max_strain", "relative_distance"};
-  auto value_of = [](const Run& r, int measure) { return measure == 0 ? r.max_strain : r.relative_distance; };
+  constexpr int kMeasures = 3;
+  const char* const measures[kMeasures] = {"max_strain", "relative_distance", "relative_distance_hard"};
+  auto value_of = [](const Run& r, int measure) {
+    return measure == 0 ? r.max_strain : measure == 1 ? r.relative_distance : r.relative_distance_hard;
+  };
   cl::CsvTable fastest({"scene", "measure", "target", "method", "iterations", "step_seconds", "value"});
   // best[measure][scene][target]
   std::vector<std::vector<std::vector<const Run*>>> best(
-      2, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(targets.size(), nullptr)));
-  for (int m = 0; m < 2; ++m) {
+      kMeasures, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(targets.size(), nullptr)));
+  for (int m = 0; m < kMeasures; ++m) {
     for (std::size_t s = 0; s < infos.size(); ++s) {
       for (std::size_t t = 0; t < targets.size(); ++t) {
         const Run*& b = best[static_cast<std::size_t>(m)][s][t];
@@ -559,8 +652,9 @@ int run(const Options& options) {
   // ---------------------------------------------------------------- summary
   std::printf("\ntrade: %zu runs on %zu scenes in %.0f s; CSV in %s\n", runs.size(), infos.size(), total.seconds(),
               options.out.c_str());
-  const char* const titles[2] = {"max strain error", "distance to the reference step / step displacement"};
-  for (int m = 0; m < 2; ++m) {
+  const char* const titles[kMeasures] = {"max strain error", "distance to the reference step / step displacement",
+                                         "distance to the hard step (k = 1e9 N/m) / its displacement"};
+  for (int m = 0; m < kMeasures; ++m) {
     std::printf("fastest method to %s <= 1e-2 and <= 1e-3 (median wall time per step):\n", titles[m]);
     std::printf("  %-12s %-30s %-30s\n", "scene", "<= 1e-2", "<= 1e-3");
     for (std::size_t s = 0; s < infos.size(); ++s) {
