@@ -33,7 +33,8 @@ usage: ./course COMMAND [ARGS]
   autograder labNN [--out FILE.zip]  the Gradescope autograder for lab NN (its hidden tests
                                      too): build/gradescope/labNN.zip
   view DIR [DIR2] [--output FILE]    DIR/view.html: a self-contained 3-D player of a run's frames
-                                     (a lab run with --frames N --out DIR); DIR2: two runs side by side
+                                     (a lab run with --frames N --out DIR); DIR2: two runs side by
+                                     side in view-DIR-vs-DIR2.html beside DIR (DIR/view.html kept)
   run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference,
                                      where solutions/ holds it
   plots [labNN ...] [DIR] [-v]       the figures whose CSV/JSON in DIR (out/, or out/labNN_name)
