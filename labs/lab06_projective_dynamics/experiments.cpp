@@ -6,15 +6,15 @@
 #include <limits>
 
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/output.h"
 
 namespace cl::lab06 {
 
-Scene load_finite_scene(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
-                        const LabOptions& lab, const std::string& name) {
-  cl::CommonOptions one = options;
-  one.scene = name;
-  cl::Scene scene = cl::load_scene_for(one, scene_dir);
+namespace {
+
+// --stiffness applied to `scene`, and its hard constraints refused.
+void make_finite(const char* lab_name, const LabOptions& lab, Scene& scene) {
   for (std::size_t e = 0; e < scene.springs.size(); ++e) {
     cl::Spring& spring = scene.springs[e];
     if (lab.stiffness) spring.stiffness = *lab.stiffness;
@@ -25,6 +25,16 @@ Scene load_finite_scene(const char* lab_name, const std::string& scene_dir, cons
                            " needs finite springs (lab 07 handles hard constraints), or pass --stiffness");
     }
   }
+}
+
+}  // namespace
+
+Scene load_finite_scene(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
+                        const LabOptions& lab, const std::string& name) {
+  cl::CommonOptions one = options;
+  one.scene = name;
+  cl::Scene scene = cl::load_scene_for(one, scene_dir);
+  make_finite(lab_name, lab, scene);
   return scene;
 }
 
@@ -80,10 +90,8 @@ Curve measure_step(Solver& solver, const cl::Particles& start, const StepSetting
 
 int run_convergence(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
                     const LabOptions& lab) {
-  std::vector<cl::Scene> scenes;
-  for (const std::string& name : lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene} : lab.sweep_scenes) {
-    scenes.push_back(load_finite_scene(lab_name, scene_dir, options, lab, name));
-  }
+  std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, scene_dir);
+  for (cl::Scene& scene : scenes) make_finite(lab_name, lab, scene);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::CsvTable curves({"scene", "particles", "unknowns", "springs", "method", "iteration", "objective", "gap",
                        "relative_error", "seconds", "setup_seconds", "factorizations", "reference_converged",

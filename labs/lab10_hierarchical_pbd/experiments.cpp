@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "common/csv.h"
+#include "common/driver.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "hpbd.h"
@@ -54,19 +55,14 @@ int sweep_limit(const LabOptions& lab, const cl::Scene& scene) {
 
 int run_converge(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
                  const LabOptions& lab) {
-  const std::vector<std::string> names =
-      lab.sweep_scenes.empty() ? std::vector<std::string>{options.scene} : lab.sweep_scenes;
   const std::vector<int> level_counts = lab.sweep_levels.empty() ? std::vector<int>{lab.levels} : lab.sweep_levels;
   if (level_counts.size() > 1 && lab.iterations_per_level.size() != 1) {
     throw cl::InputError("--iterations-per-level: with several --sweep-levels give one count (for every level)");
   }
-  std::vector<cl::Scene> scenes;
-  for (const std::string& name : names) {
-    cl::CommonOptions one = options;
-    one.scene = name;
-    scenes.push_back(cl::load_scene_for(one, scene_dir));
+  const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, scene_dir);
+  for (const cl::Scene& scene : scenes) {
     for (const int levels : level_counts) {  // reject bad input before any work
-      hierarchy_for(scenes.back(), levels);
+      hierarchy_for(scene, levels);
       if (per_level(lab, levels).front() < 1) {
         throw cl::InputError("--iterations-per-level: --converge needs at least 1 sweep on the cloth");
       }
