@@ -142,7 +142,8 @@ int main(int argc, char** argv) {
       .capture_default_str();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor ω, as in lab 03 (0 leaves x unchanged; >= 2 diverges)")
       .non_negative()
-      .capture_default_str();
+      .capture_default_str()
+      .only_for_methods({"jacobi"});
   app.add_option("--window", lab.window_seconds, "averaging window in seconds for the steady strain")
       .finite_in(1e-9, 1e9)
       .capture_default_str();
