@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """The speed/accuracy trade (issue 12): per scene, error against wall time per
 step for every method and iteration count, the Pareto front highlighted. Top
-row: max strain error; bottom row: distance to the converged reference step,
-relative to the step's displacement. Reads OUTDIR/bench/trade.csv, writes
-OUTDIR/bench/pareto.png."""
+row: max strain error; middle row: distance to the converged reference step,
+relative to the step's displacement; bottom row (when trade.csv has it): the
+same for the hard step, the hard family's own target. Reads
+OUTDIR/bench/trade.csv, writes OUTDIR/bench/pareto.png."""
+import math
 from pathlib import Path
 
 import _figures as figures
@@ -34,23 +36,28 @@ def main(out_dir):
     rows = [r for r in figures.rows(table) if not r["problem"]]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
-    colors = {m: plt.cm.tab10(i % 10) for i, m in enumerate(methods)}
-    measures = (("max_strain", "max strain error"),
-                ("relative_distance", "distance to reference step\n/ step displacement"))
-    figure, axes = plt.subplots(2, len(scenes), figsize=(3.9 * len(scenes), 7.6), squeeze=False)
+    colors = {m: plt.cm.tab20(i % 20) for i, m in enumerate(methods)}
+    measures = [("max_strain", "max strain error"),
+                ("relative_distance", "distance to reference step\n/ step displacement")]
+    if rows and "relative_distance_hard" in rows[0]:
+        measures.append(("relative_distance_hard", "distance to hard step\n/ its displacement"))
+    figure, axes = plt.subplots(len(measures), len(scenes), figsize=(3.9 * len(scenes), 3.8 * len(measures)),
+                                squeeze=False)
     for column, scene in enumerate(scenes):
         mine = [r for r in rows if r["scene"] == scene]
         for row, (key, label) in enumerate(measures):
             ax = axes[row][column]
             for method in methods:
-                runs = sorted((r for r in mine if r["method"] == method), key=lambda r: int(r["iterations"]))
+                runs = sorted((r for r in mine if r["method"] == method and math.isfinite(float(r[key]))),
+                              key=lambda r: int(r["iterations"]))
                 if not runs:
                     continue
                 t = [float(r["step_seconds"]) for r in runs]
                 e = [max(float(r[key]), 1e-16) for r in runs]
                 ax.loglog(t, e, "-", marker=FAMILY_MARKER.get(runs[0]["family"], "o"), markersize=4,
                           color=colors[method], alpha=0.85, label=f"{method} ({runs[0]['family']})")
-            best = front([(float(r["step_seconds"]), max(float(r[key]), 1e-16)) for r in mine])
+            best = front([(float(r["step_seconds"]), max(float(r[key]), 1e-16)) for r in mine
+                          if math.isfinite(float(r[key]))])
             ax.step([p[0] for p in best], [p[1] for p in best], where="post", color="black", linewidth=1.2,
                     zorder=0, label="Pareto front")
             ax.scatter([p[0] for p in best], [p[1] for p in best], s=70, facecolors="none", edgecolors="black",

@@ -33,7 +33,7 @@ def main(out_dir):
         n = [int(r["particles"]) for r in mine]
         t = [float(r["seconds_per_iteration"]) for r in mine]
         label = method if len(n) < 2 else f"{method}: p = {slope(n, t):.2f}"
-        ax.loglog(n, t, "o-", color=plt.cm.tab10(i % 10), label=label)
+        ax.loglog(n, t, "o-", color=plt.cm.tab20(i % 20), label=label)
     ax.set_xlabel("particles n (curtains 16² … 128²)")
     ax.set_ylabel("wall time per iteration (s)\n(a direct solve: per step)")
     ax.set_title("Cost of one iteration against size; fitted time ~ n^p")
