@@ -242,7 +242,7 @@ int run(const Options& options) {
     }
     if (tty) std::fprintf(stderr, "\r\033[K");
     std::map<std::string, int>& c = counts[method->name];
-    std::printf("%-16s finite %3d  reported %3d  not applicable %3d  silent NaN %3d  (%.1f s)\n", method->name.c_str(),
+    std::printf("%-23s finite %3d  reported %3d  not applicable %3d  silent NaN %3d  (%.1f s)\n", method->name.c_str(),
                 c["finite"], c["reported"], c["not-applicable"], c["silent-nan"], method_timer.seconds());
     std::fflush(stdout);
   }
