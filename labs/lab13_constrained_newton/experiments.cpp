@@ -11,7 +11,6 @@
 #include "common/csv.h"
 #include "common/driver.h"
 #include "common/output.h"
-#include "common/sparse.h"
 #include "common/timer.h"
 
 namespace cl::lab13 {
@@ -70,10 +69,6 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
   for (const std::string& w : lab.warms) warms.push_back(warm_from_name(w));
   const std::vector<Scene> scenes = load_scenes(options, lab.sweep_scenes, scene_dir);
   if (!options.out.empty()) ensure_directory(options.out);
-  // Serial methods timed side by side: CHOLMOD's BLAS on one thread too (its
-  // idle threads spin, and on a shared machine a second one slowed Newton's
-  // 64² iteration many-fold; bench/README.md).
-  set_blas_threads(1);
 
   CsvTable curves({"scene", "stiffness", "method", "start", "warm", "iteration", "seconds", "distance",
                    "force_error"});

@@ -89,6 +89,26 @@ StepReport Solver::step(Particles& particles, const Settings& settings, const It
   return report;
 }
 
+lab07::StepSolution Solver::solve(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
+                                  lab07::Method method) const {
+  if (method != lab07::Method::kSchur || springs_.empty()) return lab09::solve_stiff(step, stiffness, method);
+  // lab 09's primal Schur solve (solve_stiff_schur with every c_e > 0), with
+  // one factorization kept across iterations and steps: the eliminated
+  // matrix's pattern is M's and JᵀJ's, which hold K_g's, so its ordering and
+  // symbolic analysis are made once (SpdFactorization::refactor).
+  const lab09::EliminatedSystem system = lab09::eliminated_system(step, stiffness);
+  lab07::StepSolution solution;
+  if (!factor_.refactor(system.matrix)) {
+    solution.problem = "the eliminated matrix M - dt^2 K_g + dt^2 J^T C^-1 J is not positive definite";
+    return solution;
+  }
+  solution.velocity = factor_.solve(system.rhs);
+  solution.lambda = -(step.phi + step.dt * (step.jacobian * solution.velocity)).cwiseQuotient(step.compliance);
+  solution.ok = solution.velocity.allFinite() && solution.lambda.allFinite();
+  if (!solution.ok) solution.problem = "the Schur solve is not finite";
+  return solution;
+}
+
 StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
                            const Settings& settings, const IterationCallback& on_iteration) const {
   check(settings);
@@ -131,49 +151,57 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     at.x = x;
     lab07::LinearizedStep step = lab07::linearize(at, springs_, map_, linear);
     step.velocity = rebased_velocity(x, y, map_, settings.gravity, dt_);
-    SparseMatrix stiffness = lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression);
-    lab07::StepSolution solution = lab09::solve_stiff(step, stiffness, method);
-    if (!solution.ok && settings.compression == lab09::Compression::kKeep) {
-      // The exact matrix is not definite here (compressed springs): the Schur
-      // solve refuses it, lab 07's KKT solve (LU) takes it as it is; only when
-      // that fails too does this iteration drop them, as lab 09's step does.
+    bool exact = settings.compression == lab09::Compression::kKeep;
+    lab07::StepSolution solution =
+        solve(step, lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression), method);
+    if (!solution.ok && exact && method == lab07::Method::kSchur) {
+      // The exact matrix is not definite here (compressed springs): this
+      // iteration drops them, as lab 09's step does (README.md, "Compression").
       ++report.fallbacks;
-      if (method == lab07::Method::kSchur) solution = lab09::solve_stiff(step, stiffness, lab07::Method::kKkt);
-      if (!solution.ok) {
-        stiffness = lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kDrop);
-        solution = lab09::solve_stiff(step, stiffness, method);
-      }
+      exact = false;
+      solution = solve(step, lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kDrop), method);
     }
-    const std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
+    std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
     if (!problem.empty()) {
       report.problem = where + problem;
       return report;
     }
-    const Eigen::VectorXd dx = dt_ * solution.velocity;
-    const Eigen::VectorXd dlambda = solution.lambda - lambda;
     // The safeguard: halve α until the merit falls enough (sufficient_decrease).
     double alpha = 1.0;
     int backtracks = 0;
-    bool accepted = false;
     Eigen::Matrix3Xd trial;
     Eigen::VectorXd trial_lambda;
     Residuals trial_r;
     double trial_psi = 0.0;
-    while (true) {
-      trial = x;
-      for (int u = 0; u < map_.unknowns(); ++u) {
-        trial.col(map_.particle_of[static_cast<std::size_t>(u)]) += alpha * dx.segment<3>(3 * u);
+    auto line_search = [&](const lab07::StepSolution& direction) {
+      const Eigen::VectorXd dx = dt_ * direction.velocity;
+      const Eigen::VectorXd dlambda = direction.lambda - lambda;
+      for (alpha = 1.0;; alpha *= 0.5) {
+        trial = x;
+        for (int u = 0; u < map_.unknowns(); ++u) {
+          trial.col(map_.particle_of[static_cast<std::size_t>(u)]) += alpha * dx.segment<3>(3 * u);
+        }
+        trial_lambda = lambda + alpha * dlambda;
+        trial_r = evaluate(trial, trial_lambda);
+        trial_psi = merit(trial_r, inv_mass_, map_, weights_, dt_);
+        if (sufficient_decrease(psi, trial_psi, alpha)) return true;
+        if (backtracks == settings.max_backtracks) return false;
+        ++backtracks;
       }
-      trial_lambda = lambda + alpha * dlambda;
-      trial_r = evaluate(trial, trial_lambda);
-      trial_psi = merit(trial_r, inv_mass_, map_, weights_, dt_);
-      if (sufficient_decrease(psi, trial_psi, alpha)) {
-        accepted = true;
-        break;
+    };
+    bool accepted = line_search(solution);
+    if (!accepted && !exact && method == lab07::Method::kSchur) {
+      // Only the exact Newton direction is sure to lower ψ (ψ'(0) = −2ψ): the
+      // dropped one found no step length, so this iteration takes lab 07's
+      // KKT solve (an LU) of the exact, indefinite system instead.
+      ++report.exact_rescues;
+      const lab07::StepSolution rescue = lab09::solve_stiff(
+          step, lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kKeep), lab07::Method::kKkt);
+      if (lab07::solution_problem(rescue, step.velocity.size(), step.phi.size()).empty()) {
+        report.backtracks += backtracks;
+        backtracks = 0;
+        accepted = line_search(rescue);
       }
-      if (backtracks == settings.max_backtracks) break;
-      alpha *= 0.5;
-      ++backtracks;
     }
     report.backtracks += backtracks;
     if (!accepted) {
@@ -222,6 +250,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
     result.backtracks += report.backtracks;
     result.failed_decreases += report.failed_decreases;
     result.fallbacks += report.fallbacks;
+    result.exact_rescues += report.exact_rescues;
     if (report.problem.empty() && !report.converged && settings.tolerance > 0.0) ++result.unconverged_steps;
     if (report.problem.empty() && on_step) on_step(s, report);
     return StepVerdict{report.problem, report.problem.empty(), report.seconds};
@@ -233,7 +262,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
     return FrameMeasure{strain, energy, {},
                         {static_cast<long long>(done.iterations_done), static_cast<long long>(done.converged ? 1 : 0),
                          static_cast<long long>(done.backtracks), static_cast<long long>(done.failed_decreases),
-                         static_cast<long long>(done.fallbacks),
+                         static_cast<long long>(done.fallbacks), static_cast<long long>(done.exact_rescues),
                          done.force_error, done.constraint_error, done.merit, done.seconds, strain.max, strain.rms,
                          energy},
                         {}};
@@ -251,8 +280,8 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
 }
 
 std::vector<std::string> step_columns() {
-  return {"iterations", "converged",        "backtracks", "failed_decreases", "fallbacks",  "force_error",
-          "constraint_error", "merit", "seconds",    "max_strain",       "rms_strain", "total_energy"};
+  return {"iterations",       "converged", "backtracks", "failed_decreases", "fallbacks",  "exact_rescues",
+          "force_error",      "constraint_error", "merit", "seconds",  "max_strain", "rms_strain", "total_energy"};
 }
 
 }  // namespace cl::lab13

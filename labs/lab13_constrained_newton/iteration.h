@@ -15,7 +15,9 @@
 #include "common/particles.h"
 #include "common/sparse.h"
 #include "constrained_newton.h"
+#include "constrained.h"
 #include "geometric_stiffness.h"
+#include "step.h"
 
 namespace cl::lab13 {
 
@@ -33,11 +35,12 @@ struct Settings {
   double tolerance = 1e-8;   // convergence(): both errors ≤ this ends the step (0: run every iteration)
   Start start = Start::kPositions;
   Warm warm = Warm::kForces;
-  // Compressed springs in K_g (README.md, "Compression"): kept (kKeep, the
-  // exact Jacobian: quadratic convergence; an iteration whose Schur matrix is
-  // then not positive definite is solved by lab 07's KKT solve instead, and
-  // dropped only if that fails too: StepReport::fallbacks), or always dropped
-  // (kDrop: always definite, but a slow linear tail).
+  // Compressed springs in K_g (README.md, "Compression"): kept where the
+  // matrix stays definite (kKeep, the exact Jacobian: quadratic convergence
+  // near the step; an iteration whose matrix is then refused drops them,
+  // StepReport::fallbacks, and when that direction lowers ψ for no α, takes
+  // lab 07's KKT solve of the exact system, StepReport::exact_rescues), or
+  // always dropped (kDrop: always definite, but a slow linear tail).
   lab09::Compression compression = lab09::Compression::kKeep;
   int max_backtracks = 12;   // halvings of α before the step gives up (α ≥ 2⁻¹²)
 };
@@ -60,7 +63,8 @@ struct StepReport {
   bool converged = false;
   int backtracks = 0;          // halvings of α over the step
   int failed_decreases = 0;    // 1 when no α ≥ 2^-max_backtracks decreased ψ: the step stopped there
-  int fallbacks = 0;           // iterations whose first solve refused (kKeep: not definite), solved another way
+  int fallbacks = 0;           // iterations whose exact matrix was refused (kKeep: not definite) and dropped compression
+  int exact_rescues = 0;       // iterations whose dropped direction lowered ψ for no α and took the exact KKT solve
   double force_error = 0.0, constraint_error = 0.0, merit = 0.0;  // at the result
   double seconds = 0.0;
   std::string linear_solver;   // "schur" (every c_e > 0: lab 09's primal solve) or "kkt" (some c_e = 0)
@@ -91,9 +95,10 @@ class Solver {
   // (one per spring) towards the step for the prediction y. Each iteration:
   // residuals, convergence (stop when converged), K_g = lab09::geometric_stiffness(x, λ),
   // lab 07's linearisation at x with the velocity re-based (rebased_velocity),
-  // lab 09's solve (solve_stiff_schur when every c_e > 0, else the KKT solve),
-  // Δx = Δt v̂_new, then the safeguard: α = 1, ½, ¼, … until
-  // sufficient_decrease(ψ(0), ψ(α), α) with x + αΔx and λ + α(λ_new − λ).
+  // lab 09's solve (solve_stiff_schur when every c_e > 0, else the KKT solve;
+  // compression as Settings::compression says), Δx = Δt v̂_new, then the
+  // safeguard: α = 1, ½, ¼, … until sufficient_decrease(ψ(0), ψ(α), α) with
+  // x + αΔx and λ + α(λ_new − λ).
   StepReport iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
                      const Settings& settings, const IterationCallback& on_iteration = nullptr) const;
 
@@ -114,6 +119,12 @@ class Solver {
   double dt_;
   double length_scale_;
   Eigen::VectorXd previous_lambda_;
+  mutable SpdFactorization factor_;  // the primal Schur matrix's, kept for its symbolic analysis
+
+  // lab 09's solve of the system with K_g = stiffness (solve_stiff; the primal
+  // Schur branch through factor_).
+  lab07::StepSolution solve(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
+                            lab07::Method method) const;
 };
 
 // ------------------------------------------------------------------ a run
@@ -124,6 +135,7 @@ struct RunResult {
   int backtracks = 0;
   int failed_decreases = 0;
   int fallbacks = 0;
+  int exact_rescues = 0;
   int unconverged_steps = 0;  // steps that ended at the iteration cap or a failed decrease
   double seconds = 0.0;
   double energy_start = 0.0, energy_end = 0.0;
@@ -143,7 +155,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
                     const RunIterationCallback& on_iteration = nullptr, const FrameOutput& output = {},
                     const RunStepCallback& on_step = nullptr);
 
-// iterations, converged, backtracks, failed_decreases, fallbacks, force_error,
+// iterations, converged, backtracks, failed_decreases, fallbacks, exact_rescues, force_error,
 // constraint_error, merit, seconds, max_strain, rms_strain, total_energy.
 std::vector<std::string> step_columns();
 

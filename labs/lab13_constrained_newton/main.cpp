@@ -16,6 +16,7 @@
 #include "common/csv.h"
 #include "common/driver.h"
 #include "common/output.h"
+#include "common/sparse.h"
 #include "common/summary.h"
 #include "experiments.h"
 
@@ -98,10 +99,11 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
               settings.tolerance, scene.steps, scene.dt);
   if (!result.problem.empty()) cl::print_stopped("DIVERGED", "step", result.problem_step, scene.dt, result.problem);
   std::printf("  max strain %.3e; %lld iterations (%.2f per step), %d backtracks, %d failed decreases, "
-              "%d fallback solves, %d steps not converged\n",
+              "%d fallbacks to dropped compression, %d exact rescues, %d steps not converged\n",
               strain.max, result.iterations_done,
               result.steps_done ? static_cast<double>(result.iterations_done) / result.steps_done : 0.0,
-              result.backtracks, result.failed_decreases, result.fallbacks, result.unconverged_steps);
+              result.backtracks, result.failed_decreases, result.fallbacks, result.exact_rescues,
+              result.unconverged_steps);
   cl::print_time(result.seconds, result.steps_done, "step", static_cast<double>(result.iterations_done), "iteration");
   std::printf("\n");
   cl::print_trajectory_note(options, "step");
@@ -118,6 +120,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
     summary.extra["backtracks"] = result.backtracks;
     summary.extra["failed_decreases"] = result.failed_decreases;
     summary.extra["fallbacks"] = result.fallbacks;
+    summary.extra["exact_rescues"] = result.exact_rescues;
     summary.extra["unconverged_steps"] = result.unconverged_steps;
     summary.extra["iterations_per_step"] = iterations;
     summary.extra["force_error_per_step"] = force_errors;
@@ -169,6 +172,10 @@ int main(int argc, char** argv) {
       .range(1, 100000).capture_default_str();
   app.add_option("--pd-cap", lab.pd_cap, "--convergence: the most PD iterations").range(1, 1000000).capture_default_str();
   return cl::run_main(app, argc, argv, [&] {
+    // CHOLMOD's BLAS on one thread: the solves are small, OpenBLAS's idle
+    // threads spin (half of a 32² run's time went to sched_yield), and the
+    // experiment times serial methods side by side, as the bench does.
+    cl::set_blas_threads(1);
     lab.settings.start = cl::lab13::start_from_name(start);
     lab.settings.warm = cl::lab13::warm_from_name(warm);
     lab.settings.compression = compression == "keep" ? cl::lab09::Compression::kKeep : cl::lab09::Compression::kDrop;
