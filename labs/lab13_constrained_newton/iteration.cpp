@@ -274,6 +274,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
   const FrameLoopResult run =
       run_frame_loop(particles, step, measured, frame_plan(steps, solver.dt(), scale), with_index);
   copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.step_failed = run.step_failed;
   result.energy_start = run.energy_start;
   result.energy_end = run.energy_end;
   return result;

@@ -141,6 +141,7 @@ struct RunResult {
   double energy_start = 0.0, energy_end = 0.0;
   std::string problem;
   int problem_step = -1;
+  bool step_failed = false;  // the problem is a step that could not be taken (a singular system)
 };
 using RunIterationCallback = std::function<void(int step, const IterationRecord&)>;
 using RunStepCallback = std::function<void(int step, const StepReport&)>;  // after every step taken

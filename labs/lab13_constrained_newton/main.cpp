@@ -97,7 +97,10 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
               scene.name.c_str(), options.method.c_str(), solver.all_compliant() ? "schur" : "kkt",
               cl::lab13::start_name(settings.start), cl::lab13::warm_name(settings.warm), options.iterations,
               settings.tolerance, scene.steps, scene.dt);
-  if (!result.problem.empty()) cl::print_stopped("DIVERGED", "step", result.problem_step, scene.dt, result.problem);
+  if (!result.problem.empty()) {
+    cl::print_stopped(result.step_failed ? "STOPPED" : "DIVERGED", "step", result.problem_step, scene.dt,
+                      result.problem);
+  }
   std::printf("  max strain %.3e; %lld iterations (%.2f per step), %d backtracks, %d failed decreases, "
               "%d fallbacks to dropped compression, %d exact rescues, %d steps not converged\n",
               strain.max, result.iterations_done,
