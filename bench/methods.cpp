@@ -326,11 +326,12 @@ class ConstrainedNewtonStepper : public Stepper {
   StepOutcome step(Particles& particles) override {
     const SpdBackendCounts before = spd_backend_counts();
     const lab13::StepReport report = solver_.step(particles, settings_);
-    // Lab 09's primal (Schur) solve when every c_e > 0, with lab 07's KKT
-    // solve for an iteration whose matrix is not definite; the KKT solve (LU)
-    // when some spring is hard.
+    // Lab 09's primal (Schur) solve when every c_e > 0 (an iteration whose
+    // kept matrix is not definite drops compression: the same Cholesky), with
+    // lab 07's KKT solve (LU) for an exact rescue; the KKT solve when some
+    // spring is hard.
     std::string solver = report.linear_solver == "kkt" ? std::string("sparse-lu") : backends_since(before);
-    if (report.linear_solver != "kkt" && report.fallbacks > 0) solver += "+kkt";
+    if (report.linear_solver != "kkt" && report.exact_rescues > 0) solver += "+kkt";
     return {report.problem, report.iterations_done, solver};
   }
 

@@ -161,7 +161,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       exact = false;
       solution = solve(step, lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kDrop), method);
     }
-    std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
+    const std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
     if (!problem.empty()) {
       report.problem = where + problem;
       return report;

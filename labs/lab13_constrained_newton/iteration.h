@@ -102,7 +102,6 @@ class Solver {
   StepReport iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
                      const Settings& settings, const IterationCallback& on_iteration = nullptr) const;
 
-  void forget_lambda() { previous_lambda_.resize(0); }
   const Eigen::VectorXd& previous_lambda() const { return previous_lambda_; }
   const std::vector<Spring>& springs() const { return springs_; }
   const MovableMap& map() const { return map_; }
