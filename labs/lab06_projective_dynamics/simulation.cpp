@@ -91,81 +91,26 @@ Eigen::Matrix3d spring_block(const Eigen::Matrix3Xd& x, const Spring& spring, bo
   return spring.stiffness * (along + across * (Eigen::Matrix3d::Identity() - along));
 }
 
-constexpr int kSlotsPerSpring = 36;  // blocks aa, bb, ab, ba, each 3 × 3 column-major
-
 }  // namespace
 
-HessianAssembly::HessianAssembly(const Problem& problem) {
-  const MovableMap& map = problem.map;
-  const Eigen::Index size = 3 * static_cast<Eigen::Index>(map.unknowns());
-  std::vector<Triplet> pattern;
-  pattern.reserve(static_cast<std::size_t>(size) + 36 * problem.springs.size());
-  for (Eigen::Index k = 0; k < size; ++k) pattern.emplace_back(k, k, 0.0);
-  auto add_block = [&](int a, int b) {
-    for (int c = 0; c < 3; ++c) {
-      for (int r = 0; r < 3; ++r) pattern.emplace_back(3 * a + r, 3 * b + c, 0.0);
-    }
-  };
-  for (const Spring& spring : problem.springs) {
-    const int a = map.unknown_of[static_cast<std::size_t>(spring.i)];
-    const int b = map.unknown_of[static_cast<std::size_t>(spring.j)];
-    if (a >= 0) add_block(a, a);
-    if (b >= 0) add_block(b, b);
-    if (a >= 0 && b >= 0) {
-      add_block(a, b);
-      add_block(b, a);
-    }
-  }
-  matrix_.resize(size, size);
-  matrix_.setFromTriplets(pattern.begin(), pattern.end());  // explicit zeros are kept: the pattern
-  matrix_.makeCompressed();
-  const int* outer = matrix_.outerIndexPtr();
-  const int* inner = matrix_.innerIndexPtr();
-  auto index_of = [&](int row, int col) {
-    return static_cast<int>(std::lower_bound(inner + outer[col], inner + outer[col + 1], row) - inner);
-  };
-  diagonal_.resize(static_cast<std::size_t>(size));
-  for (int k = 0; k < static_cast<int>(size); ++k) diagonal_[static_cast<std::size_t>(k)] = index_of(k, k);
-  slots_.assign(kSlotsPerSpring * problem.springs.size(), -1);
-  for (std::size_t e = 0; e < problem.springs.size(); ++e) {
-    const int a = map.unknown_of[static_cast<std::size_t>(problem.springs[e].i)];
-    const int b = map.unknown_of[static_cast<std::size_t>(problem.springs[e].j)];
-    int* slot = slots_.data() + kSlotsPerSpring * e;
-    const int rows[4] = {a, b, a, b};
-    const int cols[4] = {a, b, b, a};
-    for (int block = 0; block < 4; ++block) {
-      if (rows[block] < 0 || cols[block] < 0) continue;
-      for (int c = 0; c < 3; ++c) {
-        for (int r = 0; r < 3; ++r) slot[9 * block + 3 * c + r] = index_of(3 * rows[block] + r, 3 * cols[block] + c);
-      }
-    }
-  }
-}
+HessianAssembly::HessianAssembly(const Problem& problem) : blocks_(problem.map, problem.springs) {}
 
 const SparseMatrix& HessianAssembly::update(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp) {
   const MovableMap& map = problem.map;
-  if (matrix_.rows() != 3 * static_cast<Eigen::Index>(map.unknowns()) ||
-      slots_.size() != kSlotsPerSpring * problem.springs.size()) {
+  if (blocks_.rows() != 3 * static_cast<Eigen::Index>(map.unknowns()) ||
+      blocks_.springs() != problem.springs.size()) {
     throw std::invalid_argument("HessianAssembly::update: the problem is not the one the pattern was made for");
   }
   const double inv_dt2 = 1.0 / (problem.dt * problem.dt);
-  double* value = matrix_.valuePtr();
-  std::fill(value, value + matrix_.nonZeros(), 0.0);
+  blocks_.set_zero();
   for (int u = 0; u < map.unknowns(); ++u) {
-    const double diagonal = inv_dt2 / problem.inv_mass[map.particle_of[static_cast<std::size_t>(u)]];
-    for (int r = 0; r < 3; ++r) value[diagonal_[static_cast<std::size_t>(3 * u + r)]] += diagonal;
+    blocks_.add_diagonal(u, inv_dt2 / problem.inv_mass[map.particle_of[static_cast<std::size_t>(u)]]);
   }
   for (std::size_t e = 0; e < problem.springs.size(); ++e) {
-    const int* slot = slots_.data() + kSlotsPerSpring * e;
-    if (slot[0] < 0 && slot[9] < 0) continue;  // both ends pinned
-    const Eigen::Matrix3d block = spring_block(x, problem.springs[e], clamp);
-    const double sign[4] = {1.0, 1.0, -1.0, -1.0};
-    for (int b = 0; b < 4; ++b) {
-      if (slot[9 * b] < 0) continue;
-      for (int k = 0; k < 9; ++k) value[slot[9 * b + k]] += sign[b] * block.data()[k];
-    }
+    if (!blocks_.has_block(e)) continue;  // both ends pinned
+    blocks_.add_spring(e, spring_block(x, problem.springs[e], clamp));
   }
-  return matrix_;
+  return blocks_.matrix();
 }
 
 SparseMatrix newton_hessian(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp) {

@@ -14,6 +14,7 @@
 #include "common/metrics.h"
 #include "common/particles.h"
 #include "common/sparse.h"
+#include "common/spring_blocks.h"
 #include "projective_dynamics.h"
 
 namespace cl::lab06 {
@@ -58,25 +59,24 @@ struct StepReport {
 };
 
 // Newton's Hessian (newton_hessian, below) assembled into a fixed sparsity
-// pattern, values only: the pattern, and where each spring's four 3×3 blocks
-// and each unknown's mass go in it, are found once (the constructor); update()
-// rewrites the values in place, with no triplets and no sort. A spring's blocks are stored even where
-// their values are 0, so the pattern is the same for every x, and the
-// factorization's ordering and symbolic analysis hold for every iteration.
+// pattern, values only (common/spring_blocks.h): the pattern, and where each
+// spring's four 3×3 blocks and each unknown's mass go in it, are found once
+// (the constructor); update() rewrites the values in place, with no triplets
+// and no sort. A spring's blocks are stored even where their values are 0, so
+// the pattern is the same for every x, and the factorization's ordering and
+// symbolic analysis hold for every iteration.
 class HessianAssembly {
  public:
   HessianAssembly() = default;  // empty(): no pattern yet
   explicit HessianAssembly(const Problem& problem);
-  bool empty() const { return matrix_.rows() == 0 && slots_.empty(); }
+  bool empty() const { return blocks_.empty(); }
   // newton_hessian(problem, x, clamp), written into the pattern. `problem`
   // must be the constructor's (same unknowns and springs: std::invalid_argument
   // otherwise). The reference stays valid until the next update.
   const SparseMatrix& update(const Problem& problem, const Eigen::Matrix3Xd& x, bool clamp = true);
 
  private:
-  SparseMatrix matrix_;        // full (both triangles), compressed
-  std::vector<int> diagonal_;  // per unknown: 3 value indices of its diagonal entries
-  std::vector<int> slots_;     // per spring: 36 value indices (blocks aa, bb, ab, ba; −1: a pinned end)
+  SpringBlockMatrix blocks_;  // full (both triangles), compressed
 };
 
 // One scene's solver. Projective dynamics factors A = system_matrix(problem)

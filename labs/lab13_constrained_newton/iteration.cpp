@@ -1,6 +1,7 @@
 // Lab 13 — given code: the constrained Newton iteration, its safeguard, the run.
 #include "iteration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -61,6 +62,7 @@ Solver::Solver(const Eigen::VectorXd& inv_mass, const std::vector<Spring>& sprin
   compliance_ = lab07::compliance_of(springs_);
   weights_ = merit_weights(springs_, inv_mass_, compliance_, dt_);
   length_scale_ = length_scale(springs_);
+  if (!springs_.empty() && all_compliant()) eliminated_ = SpringBlockMatrix(map_, springs_);
 }
 
 bool Solver::all_compliant() const {
@@ -89,21 +91,69 @@ StepReport Solver::step(Particles& particles, const Settings& settings, const It
   return report;
 }
 
-lab07::StepSolution Solver::solve(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
-                                  lab07::Method method) const {
-  if (method != lab07::Method::kSchur || springs_.empty()) return lab09::solve_stiff(step, stiffness, method);
-  // lab 09's primal Schur solve (solve_stiff_schur with every c_e > 0), with
-  // one factorization kept across iterations and steps: the eliminated
-  // matrix's pattern is M's and JᵀJ's, which hold K_g's, so its ordering and
-  // symbolic analysis are made once (SpdFactorization::refactor).
-  const lab09::EliminatedSystem system = lab09::eliminated_system(step, stiffness);
+lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
+                                       const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
+                                       lab09::Compression compression) const {
+  // Lab 09's eliminated system (geometric_stiffness.h) at x, per spring e
+  // with n = (x_i − x_j)/ℓ and s = 1/c_e: the mass on the diagonal, and the block
+  //     Δt² [ s n nᵀ − (λ_e/ℓ)(I − n nᵀ) ]       (Δt² Jᵀ C⁻¹ J − Δt² K_g)
+  // at (i,i), (j,j) and negated at (i,j), (j,i); the right-hand side
+  // M(v̂ + Δt g) − Δt Jᵀ C⁻¹ φ. Coincident ends have no direction: an empty
+  // row of J and no K_g (lab 07's and lab 09's rule), so no block.
+  const double dt2 = dt_ * dt_;
+  const std::size_t m = springs_.size();
+  Eigen::Matrix3Xd units(3, static_cast<Eigen::Index>(m));
+  Eigen::VectorXd phi(static_cast<Eigen::Index>(m));
+  Eigen::VectorXd rhs(3 * map_.unknowns());
+  eliminated_.set_zero();
+  for (int u = 0; u < map_.unknowns(); ++u) {
+    const double w = inv_mass_[map_.particle_of[static_cast<std::size_t>(u)]];
+    eliminated_.add_diagonal(u, 1.0 / w);
+    rhs.segment<3>(3 * u) = (velocity.segment<3>(3 * u) + dt_ * gravity) / w;
+  }
+  for (std::size_t e = 0; e < m; ++e) {
+    const Spring& s = springs_[e];
+    const auto index = static_cast<Eigen::Index>(e);
+    const Eigen::Vector3d d = x.col(s.i) - x.col(s.j);
+    const double length = d.norm();
+    phi[index] = length - s.rest_length;
+    if (!(length > 0.0)) {
+      units.col(index).setZero();
+      continue;
+    }
+    const Eigen::Vector3d n = d / length;
+    units.col(index) = n;
+    const double stiffness = 1.0 / compliance_[index];
+    const Eigen::Matrix3d along = n * n.transpose();
+    Eigen::Matrix3d block = (dt2 * stiffness) * along;
+    double force = lambda[index];
+    if (compression == lab09::Compression::kDrop) force = std::min(force, 0.0);
+    if (force != 0.0) block -= (dt2 * force / length) * (Eigen::Matrix3d::Identity() - along);
+    eliminated_.add_spring(e, block);
+    const Eigen::Vector3d pull = (dt_ * stiffness * phi[index]) * n;
+    const int a = map_.unknown_of[static_cast<std::size_t>(s.i)];
+    const int b = map_.unknown_of[static_cast<std::size_t>(s.j)];
+    if (a >= 0) rhs.segment<3>(3 * a) -= pull;
+    if (b >= 0) rhs.segment<3>(3 * b) += pull;
+  }
   lab07::StepSolution solution;
-  if (!factor_.refactor(system.matrix)) {
+  if (!factor_.refactor(eliminated_.matrix())) {
     solution.problem = "the eliminated matrix M - dt^2 K_g + dt^2 J^T C^-1 J is not positive definite";
     return solution;
   }
-  solution.velocity = factor_.solve(system.rhs);
-  solution.lambda = -(step.phi + step.dt * (step.jacobian * solution.velocity)).cwiseQuotient(step.compliance);
+  solution.velocity = factor_.solve(rhs);
+  // λ = −C⁻¹(φ + Δt J v_new), J v_new per spring: n·(v_i − v_j), a pinned end's v = 0.
+  solution.lambda.resize(static_cast<Eigen::Index>(m));
+  for (std::size_t e = 0; e < m; ++e) {
+    const Spring& s = springs_[e];
+    const auto index = static_cast<Eigen::Index>(e);
+    const int a = map_.unknown_of[static_cast<std::size_t>(s.i)];
+    const int b = map_.unknown_of[static_cast<std::size_t>(s.j)];
+    double rate = 0.0;
+    if (a >= 0) rate += units.col(index).dot(solution.velocity.segment<3>(3 * a));
+    if (b >= 0) rate -= units.col(index).dot(solution.velocity.segment<3>(3 * b));
+    solution.lambda[index] = -(phi[index] + dt_ * rate) / compliance_[index];
+  }
   solution.ok = solution.velocity.allFinite() && solution.lambda.allFinite();
   if (!solution.ok) solution.problem = "the Schur solve is not finite";
   return solution;
@@ -120,6 +170,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
   StepReport report;
   report.linear_solver = all_compliant() ? "schur" : "kkt";
   const lab07::Method method = all_compliant() ? lab07::Method::kSchur : lab07::Method::kKkt;
+  const bool schur = method == lab07::Method::kSchur && !springs_.empty();  // schur_solve; else solve_stiff
   lab07::StepSettings linear;
   linear.dt = dt_;
   linear.gravity = settings.gravity;
@@ -148,20 +199,33 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
   for (int k = 1; k <= settings.iterations && !stopped; ++k) {
     if ((settings.tolerance > 0.0 && c.converged) || psi == 0.0) break;
     const std::string where = "constrained newton iteration " + std::to_string(k) + ": ";
-    at.x = x;
-    lab07::LinearizedStep step = lab07::linearize(at, springs_, map_, linear);
-    step.velocity = rebased_velocity(x, y, map_, settings.gravity, dt_);
+    const Eigen::VectorXd velocity = rebased_velocity(x, y, map_, settings.gravity, dt_);
+    // Lab 07's linearisation at x with the re-based velocity: the KKT solves'
+    // input (made only when one runs).
+    auto linearized = [&]() {
+      at.x = x;
+      lab07::LinearizedStep step = lab07::linearize(at, springs_, map_, linear);
+      step.velocity = velocity;
+      return step;
+    };
     bool exact = settings.compression == lab09::Compression::kKeep;
-    lab07::StepSolution solution =
-        solve(step, lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression), method);
-    if (!solution.ok && exact && method == lab07::Method::kSchur) {
-      // The exact matrix is not definite here (compressed springs): this
-      // iteration drops them, as lab 09's step does (README.md, "Compression").
-      ++report.fallbacks;
-      exact = false;
-      solution = solve(step, lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kDrop), method);
+    lab07::StepSolution solution;
+    if (schur) {
+      solution = schur_solve(x, velocity, lambda, settings.gravity, settings.compression);
+      if (!solution.ok && exact) {
+        // The exact matrix is not definite here (compressed springs): this
+        // iteration drops them, as lab 09's step does (README.md, "Compression").
+        ++report.fallbacks;
+        exact = false;
+        solution = schur_solve(x, velocity, lambda, settings.gravity, lab09::Compression::kDrop);
+      }
+    } else {
+      solution = lab09::solve_stiff(linearized(), lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression),
+                                    method);
     }
-    const std::string problem = lab07::solution_problem(solution, step.velocity.size(), step.phi.size());
+    const auto unknowns = static_cast<Eigen::Index>(velocity.size());
+    const auto constraints = static_cast<Eigen::Index>(springs_.size());
+    const std::string problem = lab07::solution_problem(solution, unknowns, constraints);
     if (!problem.empty()) {
       report.problem = where + problem;
       return report;
@@ -190,14 +254,15 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       }
     };
     bool accepted = line_search(solution);
-    if (!accepted && !exact && method == lab07::Method::kSchur) {
+    if (!accepted && !exact && schur) {
       // Only the exact Newton direction is sure to lower ψ (ψ'(0) = −2ψ): the
       // dropped one found no step length, so this iteration takes lab 07's
       // KKT solve (an LU) of the exact, indefinite system instead.
       ++report.exact_rescues;
-      const lab07::StepSolution rescue = lab09::solve_stiff(
-          step, lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kKeep), lab07::Method::kKkt);
-      if (lab07::solution_problem(rescue, step.velocity.size(), step.phi.size()).empty()) {
+      const lab07::StepSolution rescue =
+          lab09::solve_stiff(linearized(), lab09::geometric_stiffness(x, springs_, lambda, map_, lab09::Compression::kKeep),
+                             lab07::Method::kKkt);
+      if (lab07::solution_problem(rescue, unknowns, constraints).empty()) {
         report.backtracks += backtracks;
         backtracks = 0;
         accepted = line_search(rescue);

@@ -14,6 +14,7 @@
 #include "common/frame_loop.h"
 #include "common/particles.h"
 #include "common/sparse.h"
+#include "common/spring_blocks.h"
 #include "constrained_newton.h"
 #include "constrained.h"
 #include "geometric_stiffness.h"
@@ -93,10 +94,14 @@ class Solver {
 
   // The iteration alone: x (3 × n, pinned columns as they are) and lambda
   // (one per spring) towards the step for the prediction y. Each iteration:
-  // residuals, convergence (stop when converged), K_g = lab09::geometric_stiffness(x, λ),
-  // lab 07's linearisation at x with the velocity re-based (rebased_velocity),
-  // lab 09's solve (solve_stiff_schur when every c_e > 0, else the KKT solve;
-  // compression as Settings::compression says), Δx = Δt v̂_new, then the
+  // residuals, convergence (stop when converged), v̂ = rebased_velocity, then
+  // lab 09's system at x for v̂ with K_g from λ (compression as
+  // Settings::compression says): when every c_e > 0 its primal Schur solve,
+  // the eliminated matrix M − Δt² K_g + Δt² Jᵀ C⁻¹ J written spring by spring
+  // into a fixed pattern (common/spring_blocks.h) and refactored with the
+  // kept symbolic analysis (the matrix and right-hand side of
+  // lab09::eliminated_system, to round-off); else lab 07's linearisation at x
+  // and lab 09's solve_stiff (the KKT solve). Δx = Δt v̂_new, then the
   // safeguard: α = 1, ½, ¼, … until sufficient_decrease(ψ(0), ψ(α), α) with
   // x + αΔx and λ + α(λ_new − λ).
   StepReport iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
@@ -118,12 +123,19 @@ class Solver {
   double dt_;
   double length_scale_;
   Eigen::VectorXd previous_lambda_;
-  mutable SpdFactorization factor_;  // the primal Schur matrix's, kept for its symbolic analysis
+  // The primal Schur matrix's fixed pattern and its factorization, kept for
+  // the symbolic analysis (both empty unless every c_e > 0 and m > 0).
+  mutable SpringBlockMatrix eliminated_;
+  mutable SpdFactorization factor_;
 
-  // lab 09's solve of the system with K_g = stiffness (solve_stiff; the primal
-  // Schur branch through factor_).
-  lab07::StepSolution solve(const lab07::LinearizedStep& step, const SparseMatrix& stiffness,
-                            lab07::Method method) const;
+  // Lab 09's primal Schur solve (every c_e > 0) of the system at x for the
+  // re-based velocity, with K_g from lambda (compression as given): the
+  // eliminated matrix and right-hand side of lab09::eliminated_system,
+  // assembled per spring into eliminated_, then v_new and
+  // λ = −C⁻¹(φ + Δt J v_new) as solve_stiff_schur gives them.
+  lab07::StepSolution schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
+                                  const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
+                                  lab09::Compression compression) const;
 };
 
 // ------------------------------------------------------------------ a run
