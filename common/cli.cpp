@@ -235,6 +235,9 @@ void add_common_options(CommandLine& line, CommonOptions& options, unsigned flag
 
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir, const std::string& flag) {
   Scene scene = load_scene(resolve_scene_path(options.scene, lab_scene_dir, flag));
+  if (!options.models_colliders && !scene.colliders.empty()) {
+    throw InputError(scene.source + ": colliders[0]: this lab does not model colliders (lab 14 does: lab14_contact)");
+  }
   if (options.dt > 0.0) scene.dt = options.dt;
   if (options.steps >= 0) scene.steps = options.steps;
   if (options.frames > 0) {

@@ -60,6 +60,9 @@ struct CommonOptions {
   // A sweep lab (02, 03) keeps one frame per sweep: its last frame is
   // --iterations, not the scene's steps (the trajectory's size check).
   bool frames_are_sweeps = false;
+  // Only lab 14 models colliders: every other lab refuses a scene that
+  // declares them (load_scene_for), rather than letting the cloth pass through.
+  bool models_colliders = false;
 };
 
 // The common options with a lab's defaults: its --scene and, for a lab that
@@ -85,7 +88,9 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 // Loads the scene named by --scene for a lab whose scenes live in
 // lab_scene_dir, and applies --dt and --steps. With --frames N it also refuses
 // a run without --out and one whose trajectory would be over the size cap
-// (check_trajectory_size), before anything is written. Throws InputError; an
+// (check_trajectory_size), before anything is written. A scene with colliders
+// is refused ("<file>: colliders[0]: this lab does not model colliders (lab 14
+// does)") unless options.models_colliders. Throws InputError; an
 // unknown name is blamed on `flag` (--sweep-scenes, for a sweep's scenes).
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir,
                      const std::string& flag = "--scene");

@@ -396,6 +396,61 @@ void apply_jitter(const Reader& reader, const json& jitter, Scene& scene) {
   }
 }
 
+// Colliders (lab 14): a list of planes, spheres and capsules, each with its
+// own keys and a friction coefficient. Every point, and a capsule's length,
+// must be a finite distance from the origin: the contact tests take norms of
+// differences with the particles' positions.
+void read_colliders(const Reader& reader, const json& list, Scene& scene) {
+  reader.array(list, "colliders");
+  for (std::size_t c = 0; c < list.size(); ++c) {
+    const std::string field = item("colliders", c);
+    const json& entry = list[c];
+    reader.require_object(entry, field);
+    if (!entry.contains("type")) reader.fail(field + ".type", "missing (plane, sphere or capsule)");
+    const std::string type = reader.one_of(entry["type"], field + ".type", {"plane", "sphere", "capsule"});
+    Collider collider;
+    std::vector<std::string> needed;
+    if (type == "plane") {
+      collider.shape = ColliderShape::kPlane;
+      needed = {"point", "normal"};
+    } else if (type == "sphere") {
+      collider.shape = ColliderShape::kSphere;
+      needed = {"centre", "radius"};
+    } else {
+      collider.shape = ColliderShape::kCapsule;
+      needed = {"a", "b", "radius"};
+    }
+    std::set<std::string> allowed{"type", "friction"};
+    allowed.insert(needed.begin(), needed.end());
+    reader.check_keys(entry, allowed, field);
+    for (const std::string& key : needed) {
+      if (!entry.contains(key)) reader.fail(field + "." + key, "missing (a " + type + " needs it)");
+    }
+    auto point = [&](const char* key) {
+      const Eigen::Vector3d value = reader.vec3(entry[key], field + "." + key);
+      if (!std::isfinite(value.norm())) reader.fail(field + "." + key, "too far from the origin (its norm overflows a double)");
+      return value;
+    };
+    if (collider.shape == ColliderShape::kPlane) {
+      collider.a = point("point");
+      Eigen::Vector3d normal = reader.vec3(entry["normal"], field + ".normal");
+      const double largest = normal.cwiseAbs().maxCoeff();
+      if (!(largest > 0.0)) reader.fail(field + ".normal", "must not be the zero vector");
+      normal /= largest;  // scaled first, so that a normal of 1e300s does not overflow its norm
+      collider.normal = normal.normalized();
+    } else {
+      collider.a = point(collider.shape == ColliderShape::kSphere ? "centre" : "a");
+      collider.b = collider.shape == ColliderShape::kCapsule ? point("b") : collider.a;
+      collider.radius = reader.positive(entry["radius"], field + ".radius");
+      if (!std::isfinite((collider.b - collider.a).norm() + collider.a.norm() + collider.b.norm() + collider.radius)) {
+        reader.fail(field, "its size overflows a double (ends or radius too large)");
+      }
+    }
+    collider.friction = entry.contains("friction") ? reader.non_negative(entry["friction"], field + ".friction") : 0.0;
+    scene.colliders.push_back(collider);
+  }
+}
+
 // Builds the document like nlohmann's own parser while tracking where it is,
 // so that a number too large for a double (JSON has no inf) is reported with
 // its field and index like every other rejection.
@@ -519,7 +574,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   const Reader reader(source);
   reader.require_object(root, "(top level)");
   reader.check_keys(root, {"name", "description", "gravity", "dt", "steps", "particles", "springs",
-                           "triangles", "cloth", "chain", "jitter"},
+                           "triangles", "cloth", "chain", "jitter", "colliders"},
                     "");
 
   Scene scene;
@@ -552,6 +607,7 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     apply_jitter(reader, root["jitter"], scene);
     check_finite_geometry(reader, scene, "jitter.amplitude");
   }
+  if (root.contains("colliders")) read_colliders(reader, root["colliders"], scene);
   return scene;
 }
 
@@ -603,6 +659,15 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
     known.pop_back();
   }
   throw InputError(flag + ": no scene named '" + name_or_path + "' (" + known + ")");
+}
+
+const char* shape_name(ColliderShape shape) {
+  switch (shape) {
+    case ColliderShape::kPlane: return "plane";
+    case ColliderShape::kSphere: return "sphere";
+    case ColliderShape::kCapsule: return "capsule";
+  }
+  return "plane";
 }
 
 std::string lab_scene_dir(const std::string& lab) {

@@ -19,6 +19,21 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A static collider the cloth may touch (lab 14; docs/DESIGN.md §3). Every
+// number finite; `normal` has length 1; radius > 0; friction (Coulomb's μ) >= 0.
+enum class ColliderShape { kPlane, kSphere, kCapsule };
+struct Collider {
+  ColliderShape shape = ColliderShape::kPlane;
+  Eigen::Vector3d a = Eigen::Vector3d::Zero();  // plane: a point on it; sphere: the centre; capsule: one end (m)
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();  // capsule: the other end (m; may equal a); unused otherwise
+  Eigen::Vector3d normal{0.0, 1.0, 0.0};        // plane: the unit normal, pointing to the free side
+  double radius = 0.0;                          // sphere, capsule: m, > 0
+  double friction = 0.0;                        // Coulomb's μ, >= 0
+};
+
+// "plane", "sphere" or "capsule".
+const char* shape_name(ColliderShape shape);
+
 struct Scene {
   std::string name;
   std::string source;                       // file the scene came from
@@ -28,6 +43,7 @@ struct Scene {
   Particles particles;
   std::vector<Spring> springs;       // empty unless the scene declares springs
   std::vector<Triangle> triangles;   // empty unless the scene declares triangles
+  std::vector<Collider> colliders;   // empty unless the scene declares colliders (lab 14 models them)
   // Generator layout for drawing: a cloth's grid size (0 x 0 otherwise).
   int grid_nx = 0;
   int grid_ny = 0;

@@ -176,3 +176,16 @@ TEST_CASE("finite_in accepts [low, high] and rejects nan, inf and text", "[commo
     CHECK_FALSE(check(bad).empty());
   }
 }
+
+TEST_CASE("a lab that does not model colliders refuses a scene with colliders", "[common][cli]") {
+  cl::CommonOptions options;
+  options.scene = "drape-sphere";  // lab 14's, found by name from any lab
+  const std::string lab04 = std::string(CL_SOURCE_DIR) + "/labs/lab04_pbd/scenes";
+  CHECK_THROWS_WITH(cl::load_scene_for(options, lab04),
+                    Contains("drape-sphere.json: colliders[0]: this lab does not model colliders"));
+  options.models_colliders = true;
+  CHECK(cl::load_scene_for(options, lab04).colliders.size() == 2);
+  options.scene = "curtain-8";  // without colliders: nothing new to refuse
+  options.models_colliders = false;
+  CHECK(cl::load_scene_for(options, lab04).colliders.empty());
+}

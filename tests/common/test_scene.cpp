@@ -133,3 +133,53 @@ TEST_CASE("rest length 0 is allowed", "[common][scene]") {
   const cl::Scene scene = parse(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": 0}]})");
   CHECK(scene.springs[0].rest_length == 0.0);
 }
+
+TEST_CASE("colliders are read with their defaults and a unit normal", "[common][scene]") {
+  const cl::Scene scene = parse(R"({"particles": [{"x": [0,1,0]}], "colliders": [
+      {"type": "plane", "point": [0,-1,0], "normal": [0,3,4], "friction": 0.5},
+      {"type": "sphere", "centre": [1,2,3], "radius": 0.25},
+      {"type": "capsule", "a": [0,0,0], "b": [1,0,0], "radius": 0.1, "friction": 0}]})");
+  REQUIRE(scene.colliders.size() == 3);
+  CHECK(scene.colliders[0].shape == cl::ColliderShape::kPlane);
+  CHECK_THAT(scene.colliders[0].normal.y(), WithinAbs(0.6, 1e-15));
+  CHECK_THAT(scene.colliders[0].normal.z(), WithinAbs(0.8, 1e-15));
+  CHECK_THAT(scene.colliders[0].a.y(), WithinAbs(-1.0, 0.0));
+  CHECK_THAT(scene.colliders[0].friction, WithinAbs(0.5, 0.0));
+  CHECK(scene.colliders[1].shape == cl::ColliderShape::kSphere);
+  CHECK_THAT(scene.colliders[1].radius, WithinAbs(0.25, 0.0));
+  CHECK_THAT(scene.colliders[1].friction, WithinAbs(0.0, 0.0));  // the default: frictionless
+  CHECK(scene.colliders[2].shape == cl::ColliderShape::kCapsule);
+  CHECK_THAT(scene.colliders[2].b.x(), WithinAbs(1.0, 0.0));
+  CHECK(std::string(cl::shape_name(scene.colliders[2].shape)) == "capsule");
+  // A normal of huge components is scaled before it is normalised.
+  const cl::Scene huge = parse(R"({"particles": [{"x": [0,1,0]}], "colliders": [
+      {"type": "plane", "point": [0,0,0], "normal": [1e300,1e300,0]}]})");
+  CHECK_THAT(huge.colliders[0].normal.norm(), WithinAbs(1.0, 1e-15));
+  // No colliders: none.
+  CHECK(parse(R"({"particles": [{"x": [0,0,0]}]})").colliders.empty());
+}
+
+TEST_CASE("each collider rejection names the field and index", "[common][scene]") {
+  const std::string start = R"({"particles": [{"x": [0,0,0]}], "colliders": )";
+  CHECK_THAT(rejection(start + R"({}})"), Contains("colliders: must be an array"));
+  CHECK_THAT(rejection(start + R"([{"point": [0,0,0]}]})"), Contains("colliders[0].type: missing"));
+  CHECK_THAT(rejection(start + R"([{"type": "cube"}]})"), Contains("colliders[0].type: must be one of"));
+  CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0]}]})"), Contains("colliders[0].normal: missing"));
+  CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0], "normal": [0,0,0]}]})"),
+             Contains("colliders[0].normal: must not be the zero vector"));
+  CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0], "normal": [0,1,0], "radius": 1}]})"),
+             Contains("colliders[0].radius: unknown key"));
+  CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1},
+                                   {"type": "sphere", "centre": [0,0,0], "radius": 0}]})"),
+             Contains("colliders[1].radius: must be > 0"));
+  CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1, "friction": -0.1}]})"),
+             Contains("colliders[0].friction: must be >= 0"));
+  CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [0,0,0], "radius": 1}]})"),
+             Contains("colliders[0].b: missing"));
+  CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [-1.3e154,0,0], "b": [1.3e154,0,0], "radius": 1}]})"),
+             Contains("colliders[0]: its size overflows"));
+  CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [1e308,1e308,0], "radius": 1}]})"),
+             Contains("colliders[0].centre: too far from the origin"));
+  CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,"a",0], "radius": 1}]})"),
+             Contains("colliders[0].centre[1]: must be a number"));
+}

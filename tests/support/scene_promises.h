@@ -39,6 +39,18 @@ inline std::string broken_promise(const cl::Scene& scene) {
     }
     if (!(std::isfinite(triangle.rest_area) && triangle.rest_area > 0.0)) return where + ": bad rest area";
   }
+  for (std::size_t c = 0; c < scene.colliders.size(); ++c) {
+    const cl::Collider& collider = scene.colliders[c];
+    const std::string where = "colliders[" + std::to_string(c) + "]";
+    if (!collider.a.allFinite() || !collider.b.allFinite() || !std::isfinite((collider.b - collider.a).norm())) {
+      return where + ": a point or its length is not finite";
+    }
+    if (!(std::abs(collider.normal.norm() - 1.0) <= 1e-12)) return where + ": the normal is not a unit vector";
+    if (collider.shape != cl::ColliderShape::kPlane && !(std::isfinite(collider.radius) && collider.radius > 0.0)) {
+      return where + ": radius not finite and > 0";
+    }
+    if (!(std::isfinite(collider.friction) && collider.friction >= 0.0)) return where + ": friction not finite and >= 0";
+  }
   return {};
 }
 
