@@ -1,0 +1,334 @@
+// Lab 14 — given code: detection, the three steps with contact, the frame loop.
+#include "contact_step.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "common/health.h"
+#include "common/metrics.h"
+#include "step.h"
+#include "xpbd.h"
+
+namespace cl::lab14 {
+
+const char* method_name(Method method) {
+  switch (method) {
+    case Method::kPbd: return "pbd";
+    case Method::kXpbd: return "xpbd";
+    case Method::kConstrained: return "constrained";
+  }
+  return "pbd";
+}
+
+Method method_from_name(const std::string& name) {
+  if (name == "pbd") return Method::kPbd;
+  if (name == "xpbd") return Method::kXpbd;
+  if (name == "constrained") return Method::kConstrained;
+  throw std::invalid_argument("method_from_name: unknown method '" + name + "' (pbd, xpbd, constrained)");
+}
+
+namespace {
+
+constexpr double kOnSurface = 1e-12;  // m
+
+// The contact of a segment that enters a collider, or of an end point within the margin.
+std::optional<Contact> contact_of(const Collider& collider, const Eigen::Vector3d& start, const Eigen::Vector3d& end,
+                                  double margin) {
+  const SurfacePoint at_start = surface_distance(collider, start);
+  const SurfacePoint at_end = surface_distance(collider, end);
+  const Eigen::Vector3d move = end - start;
+  auto on_segment = [&](double t) { return surface_distance(collider, start + t * move).distance; };
+  std::optional<Contact> contact;
+  // s is 1-Lipschitz: a segment shorter than the start's distance cannot reach
+  // the surface. A start on the surface up to round-off (a particle resting
+  // there, |s| ~ 1e-17 m) counts as outside, so that its contact does not
+  // switch between the two kinds with the sign of a rounding error.
+  if (at_start.distance >= -kOnSurface && at_start.distance <= move.norm()) {
+    double low = 0.0, high = 1.0;  // s is convex along the segment: ternary search for its least value
+    for (int k = 0; k < 100 && high - low > 1e-15; ++k) {
+      const double a = low + (high - low) / 3.0, b = high - (high - low) / 3.0;
+      if (on_segment(a) <= on_segment(b)) high = b; else low = a;
+    }
+    double deepest = 0.5 * (low + high);
+    if (at_end.distance < on_segment(deepest)) deepest = 1.0;
+    if (on_segment(deepest) < 0.0) {
+      double outside = 0.0, inside = deepest;  // bisection for the entry point
+      for (int k = 0; k < 200 && inside - outside > 1e-16; ++k) {
+        const double middle = 0.5 * (outside + inside);
+        if (on_segment(middle) >= 0.0) outside = middle; else inside = middle;
+      }
+      const Eigen::Vector3d entry = start + outside * move;
+      const SurfacePoint surface = surface_distance(collider, entry);
+      contact = Contact{};
+      contact->normal = surface.normal;
+      contact->point = entry - surface.distance * surface.normal;
+      contact->swept = at_end.distance >= 0.0 && at_start.distance > kOnSurface;
+      return contact;
+    }
+  }
+  if (at_end.distance < margin) {
+    contact = Contact{};
+    contact->normal = at_end.normal;
+    contact->point = end - at_end.distance * at_end.normal;
+  }
+  return contact;
+}
+
+void check_settings(const StepSettings& settings) {
+  if (!(std::isfinite(settings.dt) && settings.dt > 0.0)) {
+    throw std::invalid_argument("ContactStepper: dt must be finite and > 0 (got " + std::to_string(settings.dt) + ")");
+  }
+  if (settings.iterations < 1) {
+    throw std::invalid_argument("ContactStepper: iterations must be >= 1 (got " +
+                                std::to_string(settings.iterations) + ")");
+  }
+  if (!settings.gravity.allFinite()) throw std::invalid_argument("ContactStepper: gravity is not finite");
+  if (settings.friction && !(std::isfinite(*settings.friction) && *settings.friction >= 0.0)) {
+    throw std::invalid_argument("ContactStepper: friction must be finite and >= 0");
+  }
+}
+
+void tally(StepReport& report) {
+  for (std::size_t c = 0; c < report.contacts.size(); ++c) {
+    const Contact& contact = report.contacts[c];
+    const ContactMultipliers& lambda = report.multipliers[c];
+    if (contact.swept) ++report.swept;
+    report.max_normal_force = std::max(report.max_normal_force, lambda.normal);
+    report.normal_force += lambda.normal;
+    report.contact_force += lambda.normal * contact.normal + lambda.tangent;
+    if (lambda.normal > 0.0) {
+      const bool inside = lambda.tangent.norm() < contact.friction * lambda.normal * (1.0 - 1e-9);
+      ++(inside ? report.sticking : report.sliding);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<Contact> detect_contacts(const Eigen::Matrix3Xd& start, const Eigen::Matrix3Xd& end,
+                                     const Eigen::VectorXd& inv_mass, const std::vector<Collider>& colliders,
+                                     std::optional<double> friction, double margin) {
+  std::vector<Contact> contacts;
+  if (colliders.empty()) return contacts;
+  for (Eigen::Index i = 0; i < end.cols(); ++i) {
+    if (!(inv_mass[i] > 0.0)) continue;
+    for (std::size_t c = 0; c < colliders.size(); ++c) {
+      std::optional<Contact> contact = contact_of(colliders[c], start.col(i), end.col(i), margin);
+      if (!contact) continue;
+      contact->particle = static_cast<int>(i);
+      contact->collider = static_cast<int>(c);
+      contact->friction = friction ? *friction : colliders[c].friction;
+      contacts.push_back(*contact);
+    }
+  }
+  return contacts;
+}
+
+double max_penetration(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& inv_mass,
+                       const std::vector<Collider>& colliders) {
+  double deepest = 0.0;
+  for (const Collider& collider : colliders) {
+    for (Eigen::Index i = 0; i < x.cols(); ++i) {
+      if (inv_mass[i] > 0.0) deepest = std::max(deepest, -surface_distance(collider, x.col(i)).distance);
+    }
+  }
+  return deepest;
+}
+
+ContactStepper::ContactStepper(const Scene& scene, const StepSettings& settings)
+    : settings_(settings),
+      colliders_(scene.colliders),
+      springs_(scene.springs),
+      constraints_(lab04::make_constraint_set(scene.particles.size(), scene.springs)),
+      map_(make_movable_map(scene.particles.inv_mass)) {
+  check_settings(settings_);
+}
+
+StepReport ContactStepper::step(Particles& particles) {
+  return settings_.method == Method::kConstrained ? constrained_step(particles) : position_step(particles);
+}
+
+StepReport ContactStepper::position_step(Particles& particles) {
+  const Eigen::Matrix3Xd start = particles.x;
+  if (settings_.method == Method::kPbd) {
+    lab04::PbdSettings pbd;
+    pbd.dt = settings_.dt;
+    pbd.gravity = settings_.gravity;
+    pbd.iterations = settings_.iterations;
+    lab04::pbd_step(particles, constraints_, pbd);
+  } else {
+    lab08::XpbdSettings xpbd;
+    xpbd.dt = settings_.dt;
+    xpbd.gravity = settings_.gravity;
+    xpbd.iterations = settings_.iterations;
+    lab08::xpbd_step(particles, constraints_, xpbd, xpbd_lambda_);
+  }
+  StepReport report;
+  report.contacts = detect_contacts(start, particles.x, particles.inv_mass, colliders_, settings_.friction, 0.0);
+  if (report.contacts.empty()) return report;
+  report.multipliers.assign(report.contacts.size(), ContactMultipliers{});
+  std::vector<int> stuck(report.contacts.size(), -1);
+  const double dt2 = settings_.dt * settings_.dt;
+  for (int pass = 0; pass < settings_.iterations; ++pass) {
+    for (std::size_t c = 0; c < report.contacts.size(); ++c) {
+      const Contact& contact = report.contacts[c];
+      const double w = particles.inv_mass[contact.particle];
+      auto p = particles.x.col(contact.particle);
+      const ContactProjection projection = project_contact(p, w, contact.normal, contact.point);
+      p += projection.dx;
+      bool static_case = false;
+      const Eigen::Vector3d correction = friction_correction(start.col(contact.particle), p, w, contact.normal,
+                                                             projection.depth, contact.friction, static_case);
+      p += correction;
+      report.multipliers[c].normal += projection.depth / (w * dt2);
+      report.multipliers[c].tangent += correction / (w * dt2);
+      if (projection.depth > 0.0) stuck[c] = static_case ? 1 : 0;
+    }
+  }
+  for (const Contact& contact : report.contacts) {
+    particles.v.col(contact.particle) = (particles.x.col(contact.particle) - start.col(contact.particle)) / settings_.dt;
+  }
+  for (std::size_t c = 0; c < report.contacts.size(); ++c) {
+    if (report.contacts[c].swept) ++report.swept;
+    const ContactMultipliers& lambda = report.multipliers[c];
+    report.max_normal_force = std::max(report.max_normal_force, lambda.normal);
+    report.normal_force += lambda.normal;
+    report.contact_force += lambda.normal * report.contacts[c].normal + lambda.tangent;
+    if (stuck[c] == 1) ++report.sticking;
+    if (stuck[c] == 0) ++report.sliding;
+  }
+  return report;
+}
+
+StepReport ContactStepper::constrained_step(Particles& particles) {
+  const double dt = settings_.dt;
+  lab07::StepSettings seven;
+  seven.dt = dt;
+  seven.gravity = settings_.gravity;
+  const int unknowns = map_.unknowns();
+  Eigen::VectorXd w(3 * unknowns), free(3 * unknowns);
+  for (int k = 0; k < unknowns; ++k) {
+    const int p = map_.particle_of[static_cast<std::size_t>(k)];
+    w.segment<3>(3 * k).setConstant(particles.inv_mass[p]);
+    free.segment<3>(3 * k) = particles.v.col(p) + dt * settings_.gravity;
+  }
+  // The spring rows: lab 07's Schur matrix A = Δt² J W Jᵀ + C and right-hand side −φ − ΔtJ(v + Δtg).
+  const bool with_springs = !springs_.empty() && unknowns > 0;
+  lab07::LinearizedStep lin;
+  SpdFactorization& schur = schur_;
+  Eigen::VectorXd rhs;
+  StepReport report;
+  if (with_springs) {
+    lin = lab07::linearize(particles, springs_, map_, seven);
+    SparseMatrix a = (dt * dt) * (lin.jacobian * w.asDiagonal() * lin.jacobian.transpose());
+    if (lin.compliance.size() > 0) {
+      SparseMatrix c(a.rows(), a.cols());
+      std::vector<Triplet> entries;
+      for (Eigen::Index e = 0; e < lin.compliance.size(); ++e) entries.emplace_back(e, e, lin.compliance[e]);
+      c.setFromTriplets(entries.begin(), entries.end());
+      a += c;
+    }
+    if (!schur.refactor(a)) {
+      report.problem = "singular: the springs' Schur matrix is not positive definite (redundant hard springs?)";
+      return report;
+    }
+    rhs = -lin.phi - dt * (lin.jacobian * free);
+  }
+  Eigen::VectorXd force = Eigen::VectorXd::Zero(3 * unknowns);  // contact forces J_cᵀλ_c, N
+  Eigen::VectorXd velocity = free;
+  for (int iteration = 0; iteration < settings_.iterations; ++iteration) {
+    if (with_springs) {
+      const Eigen::VectorXd lambda = schur.solve(rhs - (dt * dt) * (lin.jacobian * w.cwiseProduct(force)));
+      velocity = free + dt * w.cwiseProduct(Eigen::VectorXd(lin.jacobian.transpose() * lambda) + force);
+    } else {
+      velocity = free + dt * w.cwiseProduct(force);
+    }
+    if (iteration == 0) {
+      Eigen::Matrix3Xd end = particles.x;
+      double margin = 0.0;
+      for (int k = 0; k < unknowns; ++k) {
+        const int p = map_.particle_of[static_cast<std::size_t>(k)];
+        end.col(p) += dt * velocity.segment<3>(3 * k);
+        margin = std::max(margin, dt * velocity.segment<3>(3 * k).norm());
+      }
+      report.contacts = detect_contacts(particles.x, end, particles.inv_mass, colliders_, settings_.friction, margin);
+      report.multipliers.assign(report.contacts.size(), ContactMultipliers{});
+      if (report.contacts.empty()) break;
+    }
+    for (std::size_t c = 0; c < report.contacts.size(); ++c) {
+      const Contact& contact = report.contacts[c];
+      const int k = map_.unknown_of[static_cast<std::size_t>(contact.particle)];
+      Eigen::Vector3d v = velocity.segment<3>(3 * k);
+      const ContactMultipliers before = report.multipliers[c];
+      contact_pgs_update(particles.x.col(contact.particle), particles.inv_mass[contact.particle], dt, contact,
+                         report.multipliers[c], v);
+      velocity.segment<3>(3 * k) = v;
+      force.segment<3>(3 * k) += (report.multipliers[c].normal - before.normal) * contact.normal +
+                                 (report.multipliers[c].tangent - before.tangent);
+    }
+  }
+  lab07::update_positions(particles, map_, velocity, dt);
+  tally(report);
+  return report;
+}
+
+RunResult run_steps(Particles& particles, ContactStepper& stepper, const std::vector<Spring>& springs,
+                    const std::vector<Collider>& colliders, int steps, const FrameCallback& on_frame,
+                    const FrameOutput& output) {
+  const StepSettings& settings = stepper.settings();
+  RunResult result;
+  FramePlan plan = frame_plan(steps, settings.dt, energy_scale(particles, settings.gravity, settings.dt));
+  plan.energy_name = "kinetic + potential energy";
+  FrameRecord record;
+  StepReport last;
+  auto step = [&](int) {
+    last = stepper.step(particles);
+    StepVerdict verdict;
+    if (!last.problem.empty()) {
+      verdict.problem = last.problem;
+      verdict.taken = false;
+    }
+    return verdict;
+  };
+  auto measure = [&](int frame, double seconds) {
+    record = FrameRecord{};
+    record.frame = frame;
+    record.time = frame * settings.dt;
+    record.strain = strain_stats(particles.x, springs);
+    record.kinetic = kinetic_energy(particles);
+    record.potential = potential_energy(particles, settings.gravity);
+    record.penetration = max_penetration(particles.x, particles.inv_mass, colliders);
+    if (frame > 0) record.report = last;
+    record.seconds = seconds;
+    const StepReport& r = record.report;
+    const double total = record.kinetic + record.potential;
+    if (frame == 0) result.energy_start = total;
+    result.energy_end = total;
+    if (frame > 0) result.max_penetration = std::max(result.max_penetration, record.penetration);
+    result.max_normal_force = std::max(result.max_normal_force, r.max_normal_force);
+    result.contacts += static_cast<long long>(r.contacts.size());
+    result.swept += r.swept;
+    result.sticking += r.sticking;
+    result.sliding += r.sliding;
+    FrameMeasure measured;
+    measured.strain = record.strain;
+    measured.energy = total;
+    measured.row = {static_cast<long long>(r.contacts.size()), static_cast<long long>(r.swept),
+                    static_cast<long long>(r.sticking), static_cast<long long>(r.sliding), record.penetration,
+                    r.max_normal_force, r.normal_force, record.kinetic, record.potential, total, record.strain.max,
+                    seconds};
+    return measured;
+  };
+  const FrameLoopResult run = run_frame_loop(particles, step, measure, plan, output, record_hook(record, on_frame));
+  copy_outcome(run, result, result.steps_done, result.problem_step);
+  result.step_failed = run.step_failed;
+  return result;
+}
+
+std::vector<std::string> step_columns() {
+  return {"contacts", "swept", "sticking", "sliding", "max_penetration", "max_normal_force", "normal_force",
+          "kinetic", "potential", "total_energy", "max_strain", "seconds"};
+}
+
+}  // namespace cl::lab14

@@ -1,0 +1,56 @@
+#pragma once
+// Lab 14 — given code: the driver's options and the experiments (--drape,
+// --incline); main.cpp keeps the flags, the dispatch and one run's report.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/cli.h"
+#include "common/scene.h"
+#include "contact_step.h"
+
+namespace cl::lab14 {
+
+// What lab14_contact's own flags set (main.cpp).
+struct LabOptions {
+  std::optional<double> friction;                 // --friction: μ for every collider
+  bool drape = false;                             // experiment 1
+  bool incline = false;                           // experiment 2
+  std::vector<double> frictions;                  // --frictions (empty: kFrictions)
+  std::vector<double> angles;                     // --angles, degrees (empty: kAngles)
+};
+
+// The experiments' defaults: μ ∈ {0, 0.3, 1} (--drape, --incline), and θ in
+// degrees around atan 0.3 = 16.70° and atan 1 = 45° (--incline).
+inline const std::vector<double> kFrictions{0.0, 0.3, 1.0};
+inline const std::vector<double> kAngles{5, 10, 15, 16, 16.5, 16.9, 17, 20, 30, 40, 44, 44.9, 45.1, 46, 50, 60};
+
+// Throws InputError for --frictions or --angles given without an experiment,
+// or a friction that is not a finite number >= 0.
+void check_lab_options(const LabOptions& lab);
+
+// The step settings of a run: --method, --iterations, the scene's dt and
+// gravity, --friction.
+StepSettings step_settings(const Scene& scene, const CommonOptions& options, const LabOptions& lab);
+
+// The incline of experiment 2 and the graded tests: one particle of mass 1 kg
+// resting on a plane through the origin tilted by `degrees` about z (normal
+// (−sin θ, cos θ, 0)), gravity (0, −9.81, 0), with friction μ, dt 1/60 s.
+Scene incline_scene(double degrees, double friction, int steps);
+
+// Experiment 1: the scene (--scene) with each method and each μ of
+// --frictions (--iterations, --steps): the worst penetration, the final
+// kinetic + potential energy, the time per step, and the time to rest (the
+// first step from which the kinetic energy per kilogram stays below 1e-4
+// J/kg to the end; empty when it never does) -> OUT/drape.csv, a table.
+int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab);
+
+// Experiment 2: for each method, each μ of --frictions and each θ of
+// --angles, 100 steps of incline_scene: whether the particle stuck (moved
+// less than 1e-12 m along the slope), its acceleration along the slope (from
+// the velocity after 100 steps) and Coulomb's g (sin θ − μ cos θ) ->
+// OUT/incline.csv, and per method and μ the largest θ that sticks against
+// atan μ on the terminal.
+int run_incline(const char* lab_name, const CommonOptions& options, const LabOptions& lab);
+
+}  // namespace cl::lab14

@@ -1,0 +1,102 @@
+// lab14_contact: a scene with colliders, stepped by PBD (lab 04), XPBD (lab 08)
+// or lab 07's constrained step with the contact rows solved by projected
+// Gauss-Seidel: per_step.csv (contacts, penetration, normal forces, stick and
+// slide, energy) and the run summary. The experiments (experiments.cpp):
+//   --drape     every method × --frictions on the scene: drape.csv
+//   --incline   the stick/slip boundary against μ per method: incline.csv
+#include <cstdio>
+#include <optional>
+#include <string>
+
+#include "common/cli.h"
+#include "common/driver.h"
+#include "common/output.h"
+#include "common/sparse.h"
+#include "common/summary.h"
+#include "contact_step.h"
+#include "experiments.h"
+
+namespace {
+
+constexpr const char* kLab = CL_LAB_NAME;
+using cl::lab14::LabOptions;
+
+int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
+  cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (!options.out.empty()) cl::ensure_directory(options.out);
+  const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
+  cl::lab14::ContactStepper stepper(scene, settings);
+  const cl::FrameOutput output =
+      cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab14::step_columns(), options.method);
+  cl::Particles& particles = scene.particles;
+  const cl::lab14::RunResult result =
+      cl::lab14::run_steps(particles, stepper, scene.springs, scene.colliders, scene.steps, nullptr, output);
+  const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
+  const double per_step = result.steps_done > 0 ? static_cast<double>(result.contacts) / result.steps_done : 0.0;
+
+  std::printf("%s: scene %s, %zu collider(s), %s, K = %d, friction %s, %d steps of %.4g s\n", kLab,
+              cl::describe(scene).c_str(), scene.colliders.size(), options.method.c_str(), options.iterations,
+              lab.friction ? std::to_string(*lab.friction).c_str() : "the colliders'", scene.steps, scene.dt);
+  if (!result.problem.empty()) {
+    cl::print_stopped(result.step_failed ? "STOPPED" : "DIVERGED", "step", result.problem_step, scene.dt,
+                      result.problem);
+  }
+  std::printf("  contacts %.1f per step (%lld swept), %lld sticking and %lld sliding contact-steps\n", per_step,
+              result.swept, result.sticking, result.sliding);
+  std::printf("  worst penetration %.3e m, largest normal force %.6g N, max strain %.3e\n", result.max_penetration,
+              result.max_normal_force, strain.max);
+  cl::print_energies("  energy: ", cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
+                     std::nullopt, result.energy_start);
+  cl::print_time(result.seconds, result.steps_done, "step");
+  std::printf("\n");
+  cl::print_trajectory_note(options, "step");
+  if (!options.summary.empty()) {
+    cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
+    summary.iterations = options.iterations;
+    if (lab.friction) summary.extra["friction"] = *lab.friction;
+    summary.extra["contacts_per_step"] = per_step;
+    summary.extra["swept_contacts"] = result.swept;
+    summary.extra["sticking"] = result.sticking;
+    summary.extra["sliding"] = result.sliding;
+    summary.extra["max_penetration"] = result.max_penetration;
+    summary.extra["max_normal_force"] = result.max_normal_force;
+    cl::add_energies(summary, cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
+                     std::nullopt, result.energy_start);
+    cl::add_stop_outcome(summary, result.problem.empty() ? "" : (result.step_failed ? result.problem : "diverged: " + result.problem),
+                         "singular", result.problem_step);
+    cl::write_summary(options.summary, summary);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  cl::CommandLine app{
+      "Lab 14: contact with planes, spheres and capsules, with Coulomb friction, by PBD, XPBD or the constrained "
+      "step with projected Gauss-Seidel. Runs a scene, or one of the experiments (--drape, --incline).",
+      CL_PROGRAM_NAME};
+  cl::CommonOptions options = cl::lab_defaults("drape-sphere", "pbd", {"pbd", "xpbd", "constrained"});
+  options.iterations = 10;
+  options.models_colliders = true;
+  cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
+                                           cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
+  app.get_option("--iterations").range(1, 100000);
+  LabOptions lab;
+  app.add_option("--friction", lab.friction, "Coulomb's mu for every collider (default: each collider's own)")
+      .non_negative();
+  app.add_flag("--drape", lab.drape, "experiment 1: every method x --frictions on the scene -> drape.csv");
+  app.add_flag("--incline", lab.incline, "experiment 2: the stick/slip boundary against mu per method -> incline.csv");
+  app.add_option("--frictions", lab.frictions, "--drape, --incline: the friction coefficients (default 0,0.3,1)")
+      .delimiter(',');
+  app.add_option("--angles", lab.angles, "--incline: the incline's angles, degrees in (0, 90) (default: 16 around "
+                                         "atan 0.3 and atan 1)").delimiter(',');
+  return cl::run_main(app, argc, argv, [&] {
+    cl::set_blas_threads(1);  // CHOLMOD's BLAS: small solves, and idle OpenBLAS threads spin (lab 13)
+    cl::lab14::check_lab_options(lab);
+    if (lab.drape && lab.incline) throw cl::InputError("--incline: not together with --drape");
+    if (lab.drape) return cl::lab14::run_drape(kLab, CL_LAB_SCENE_DIR, options, lab);
+    if (lab.incline) return cl::lab14::run_incline(kLab, options, lab);
+    return run_one(options, lab);
+  });
+}

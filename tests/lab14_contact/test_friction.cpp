@@ -1,0 +1,49 @@
+// TODO(lab14.3): position-based Coulomb friction (Macklin et al. 2014, eqs. 24-25).
+#include <cmath>
+#include <stdexcept>
+
+#include <catch2/catch.hpp>
+
+#include "contact.h"
+#include "tests/support/checks.h"
+
+TEST_CASE("friction undoes the tangential move inside the cone", "[lab14][pts=2]") {
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.0, 3.0, 4.0) / 5.0;
+  const Eigen::Vector3d x(0.2, 0.1, -0.3);
+  const Eigen::Vector3d tangent(1.0, 0.0, 0.0);
+  const double depth = 0.01;
+  for (const double mu : {0.5, 1.0, 3.0}) {
+    // ‖Δx_t‖ = 0.004 <= μ d = 0.005 … 0.03; a normal part in the move must not count.
+    const Eigen::Vector3d p = x + 0.004 * tangent - 0.02 * normal;
+    CAPTURE(mu);
+    bool stuck = false;
+    const Eigen::Vector3d correction = cl::lab14::friction_correction(x, p, 2.0, normal, depth, mu, stuck);
+    CHECK(cl::test::near(correction, Eigen::Vector3d(-0.004 * tangent), 1e-16, "correction"));
+    CHECK(cl::test::answer("friction_correction(...) stuck", stuck, true, "‖Δx_t‖ <= μ d"));
+  }
+}
+
+TEST_CASE("kinetic friction shortens the tangential move by mu d and never reverses it", "[lab14][pts=2]") {
+  const Eigen::Vector3d normal(0.0, 1.0, 0.0);
+  const Eigen::Vector3d x(0.0, 0.0, 0.0);
+  const Eigen::Vector3d move(0.03, -0.002, -0.04);  // tangential part (0.03, 0, −0.04), length 0.05
+  for (const double mu : {0.0, 0.2, 0.9, 0.999}) {
+    const double depth = 0.05;
+    CAPTURE(mu);
+    bool stuck = true;
+    const Eigen::Vector3d correction = cl::lab14::friction_correction(x, x + move, 1.0, normal, depth, mu, stuck);
+    const Eigen::Vector3d tangential(0.03, 0.0, -0.04);
+    CHECK(cl::test::near(correction, Eigen::Vector3d(-tangential * (mu * depth / 0.05)), 1e-17, "correction"));
+    CHECK(cl::test::near(normal.dot(correction), 0.0, 1e-17, "normal part of the correction"));
+    CHECK(cl::test::at_least("(move + correction)·move_t (never reversed)", (move + correction).dot(tangential), 0.0));
+    CHECK(cl::test::answer("friction_correction(...) stuck", stuck, false, "‖Δx_t‖ > μ d"));
+  }
+  bool stuck = true;
+  CHECK(cl::test::near(cl::lab14::friction_correction(x, x + move, 0.0, normal, 0.05, 5.0, stuck),
+                       Eigen::Vector3d::Zero(), 0.0, "pinned"));
+  CHECK(cl::test::near(cl::lab14::friction_correction(x, x + move, 1.0, normal, 0.0, 5.0, stuck),
+                       Eigen::Vector3d::Zero(), 0.0, "no normal correction"));
+  CHECK(cl::test::answer("friction_correction(d = 0) stuck", stuck, false, "no contact force, no static friction"));
+  CHECK_THROWS_AS(cl::lab14::friction_correction(x, x + move, 1.0, normal, -0.1, 0.5, stuck), std::invalid_argument);
+  CHECK_THROWS_AS(cl::lab14::friction_correction(x, x + move, 1.0, normal, 0.1, -0.5, stuck), std::invalid_argument);
+}
