@@ -1,0 +1,331 @@
+#include "common/live.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <sstream>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "common/health.h"
+#include "common/live_server.h"
+#include "common/metrics.h"
+#include "common/summary.h"
+#include "common/timer.h"
+#include "common/trajectory.h"
+
+#ifndef CL_SOURCE_DIR
+#define CL_SOURCE_DIR "."
+#endif
+
+namespace cl {
+
+namespace {
+
+std::atomic<bool> live_stop_requested{false};
+extern "C" void live_on_signal(int) { live_stop_requested = true; }
+
+std::string read_text(const std::string& path, const char* hint) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(std::string("--live: ") + path + " not found (" + hint + ")");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void replace_once(std::string& text, const std::string& mark, const std::string& with) {
+  const std::size_t at = text.find(mark);
+  if (at != std::string::npos) text.replace(at, mark.size(), with);
+}
+
+// A particle held by a client: its target and the positions of its last few
+// steps (the release velocity), and the inverse mass it had.
+struct Hold {
+  int client = 0;
+  double inv_mass = 0.0;
+  Eigen::Vector3d target = Eigen::Vector3d::Zero();
+  std::vector<Eigen::Vector3d> trail;  // newest last, at most kTrail
+};
+constexpr std::size_t kTrail = 4;
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+std::string live_page() {
+  const std::string three = "/usr/share/javascript/three/";
+  const char* hint = "install Debian's libjs-three: ./course installs it";
+  std::string page = read_text(std::string(CL_SOURCE_DIR) + "/tools/cl/live_page.html", "the course's tree");
+  replace_once(page, "<!--three-->",
+               "<script>\n" + read_text(three + "three.min.js", hint) + "\n</script>\n<script>\n" +
+                   read_text(three + "examples/js/controls/OrbitControls.js", hint) + "\n</script>");
+  replace_once(page, "<!--player-->",
+               "<script>\n" + read_text(std::string(CL_SOURCE_DIR) + "/tools/cl/view_player.js", "the course's tree") +
+                   "\n</script>");
+  return page;
+}
+
+int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const std::string& summary_path) {
+  Particles& state = scene.particles;
+  const Particles start = state;
+  const Eigen::Index n = state.size();
+  double free_inv_mass = 0.0;  // for freeing a particle the scene pinned: the mean of the free ones'
+  int free_count = 0;
+  for (Eigen::Index p = 0; p < n; ++p) {
+    if (start.inv_mass[p] > 0.0) free_inv_mass += start.inv_mass[p], ++free_count;
+  }
+  free_inv_mass = free_count > 0 ? free_inv_mass / free_count : 1.0;
+
+  Knobs knobs = run.knobs;
+  const int dt_knob = knobs.find("dt");
+  auto dt_now = [&] { return dt_knob >= 0 ? knobs[static_cast<std::size_t>(dt_knob)] : scene.dt; };
+  auto energy_of = [&](const Particles& particles) {
+    return run.energy ? run.energy(particles)
+                      : kinetic_energy(particles) + potential_energy(particles, scene.gravity);
+  };
+
+  LiveServer server(options.port, live_page());
+  std::printf("%s\n", server.url().c_str());
+  std::fflush(stdout);
+  live_stop_requested = false;
+  struct sigaction action {};
+  struct sigaction old_int {};
+  struct sigaction old_term {};
+  action.sa_handler = live_on_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, &old_int);
+  sigaction(SIGTERM, &action, &old_term);
+
+  std::map<int, Hold> holds;   // by particle
+  std::map<int, long> sent;    // per client: the version of the state it was last sent
+  long version = 0;            // the state's, +1 at every change the page should see
+  int frame = 0, steps_done = 0;
+  double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
+  bool paused = false, stop = false, step_once = false, changed = false, refactored = false, rebase = true;
+  std::string problem;
+  double energy_start = 0.0, energy_limit = 0.0, energy_now = energy_of(state);
+  StrainStats strain = strain_stats(state.x, scene.springs);
+  Clock::time_point next_due = Clock::now();
+
+  auto send_error = [&](int client, const std::string& line) {
+    std::fprintf(stderr, "%s\n", line.c_str());
+    server.send_text(client, nlohmann::json{{"type", "error"}, {"text", line}}.dump());
+  };
+  auto release = [&](std::map<int, Hold>::iterator hold) {
+    const int p = hold->first;
+    state.inv_mass[p] = hold->second.inv_mass;
+    const std::vector<Eigen::Vector3d>& trail = hold->second.trail;
+    state.v.col(p).setZero();
+    if (trail.size() >= 2) state.v.col(p) = (trail.back() - trail.front()) / (dt_now() * double(trail.size() - 1));
+    holds.erase(hold);
+    changed = rebase = true;
+    ++version;
+  };
+  auto hello = [&](int client) {
+    nlohmann::json springs = nlohmann::json::array(), rest = nlohmann::json::array();
+    for (const Spring& spring : scene.springs) springs.push_back(spring.i), springs.push_back(spring.j), rest.push_back(spring.rest_length);
+    nlohmann::json triangles = nlohmann::json::array();
+    for (const Triangle& triangle : scene.triangles) {
+      triangles.push_back(triangle.i), triangles.push_back(triangle.j), triangles.push_back(triangle.k);
+    }
+    server.send_text(client, nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
+                                            {"method", run.method}, {"particles", n}, {"springs", springs},
+                                            {"triangles", triangles}, {"rest_lengths", rest}, {"knobs", nlohmann::json::parse(knobs.json())},
+                                            {"energy_name", run.energy_name}, {"command", command_line()}}
+                                 .dump());
+  };
+
+  auto apply = [&](const LiveInbound& inbound) {
+    if (inbound.opened) {
+      hello(inbound.client);
+      return;
+    }
+    if (inbound.closed) {
+      sent.erase(inbound.client);
+      for (auto hold = holds.begin(); hold != holds.end();) {
+        auto next = std::next(hold);
+        if (hold->second.client == inbound.client) release(hold);
+        hold = next;
+      }
+      return;
+    }
+    const LiveParse parse = parse_live_message(inbound.text, knobs, n);
+    if (!parse.ok()) return send_error(inbound.client, parse.error);
+    const LiveCommand& command = parse.command;
+    const int p = command.particle;
+    switch (command.kind) {
+      case LiveCommandKind::kPause: paused = true; break;
+      case LiveCommandKind::kResume:
+      case LiveCommandKind::kStep:
+        if (!problem.empty()) return send_error(inbound.client, "live: the run stopped at frame " + std::to_string(frame) + ": reset it first");
+        if (command.kind == LiveCommandKind::kStep) step_once = paused = true;
+        else paused = false, next_due = Clock::now();
+        break;
+      case LiveCommandKind::kReset:
+        state = start;
+        holds.clear();
+        problem.clear();
+        frame = 0, time = 0.0;
+        changed = rebase = true;
+        break;
+      case LiveCommandKind::kStop: stop = true; break;
+      case LiveCommandKind::kAck: server.acknowledge(inbound.client); return;
+      case LiveCommandKind::kSpeed: speed = command.value; break;
+      case LiveCommandKind::kSet:
+        knobs.set(static_cast<std::size_t>(command.knob), command.value);
+        changed = rebase = true;
+        break;
+      case LiveCommandKind::kDrag: {
+        auto hold = holds.find(p);
+        if (hold != holds.end() && hold->second.client != inbound.client) {
+          return send_error(inbound.client, "live: drag: particle " + std::to_string(p) + " is held by another page");
+        }
+        if (hold == holds.end()) {
+          if (state.inv_mass[p] <= 0.0) {
+            return send_error(inbound.client, "live: drag: particle " + std::to_string(p) + " is pinned (unpin it first)");
+          }
+          for (auto other = holds.begin(); other != holds.end();) {  // one particle per page at a time
+            auto next = std::next(other);
+            if (other->second.client == inbound.client) release(other);
+            other = next;
+          }
+          hold = holds.emplace(p, Hold{inbound.client, state.inv_mass[p], command.target, {}}).first;
+          state.inv_mass[p] = 0.0;
+          changed = true;
+        }
+        hold->second.target = command.target;
+        state.x.col(p) = command.target;
+        state.v.col(p).setZero();
+        break;
+      }
+      case LiveCommandKind::kRelease: {
+        const auto hold = holds.find(p);
+        if (hold == holds.end() || hold->second.client != inbound.client) {
+          return send_error(inbound.client, "live: release: particle " + std::to_string(p) + " is not held by this page");
+        }
+        release(hold);
+        break;
+      }
+      case LiveCommandKind::kPin:
+        if (holds.count(p)) return send_error(inbound.client, "live: pin: particle " + std::to_string(p) + " is held (release it first)");
+        state.inv_mass[p] = state.inv_mass[p] > 0.0 ? 0.0 : (start.inv_mass[p] > 0.0 ? start.inv_mass[p] : free_inv_mass);
+        state.v.col(p).setZero();
+        changed = rebase = true;
+        break;
+    }
+    ++version;
+  };
+
+  auto step = [&] {
+    const Timer timer;
+    if (changed && run.changed) run.changed(knobs), refactored = true;
+    changed = false;
+    const StepVerdict verdict = run.step(knobs);
+    for (auto& [p, hold] : holds) {  // a held particle is where the page holds it, whatever the step did
+      state.x.col(p) = hold.target;
+      state.v.col(p).setZero();
+      hold.trail.push_back(hold.target);
+      if (hold.trail.size() > kTrail) hold.trail.erase(hold.trail.begin());
+    }
+    previous_step_seconds = last_step_seconds;
+    last_step_seconds = verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds();
+    seconds += last_step_seconds;
+    if (verdict.taken) ++frame, ++steps_done, time += dt_now();
+    strain = strain_stats(state.x, scene.springs);
+    energy_now = energy_of(state);
+    problem = verdict.problem;
+    if (problem.empty()) problem = health_problem(state, strain);
+    if (problem.empty() && rebase) {
+      energy_start = energy_now;
+      energy_limit = energy_scale(state, scene.gravity, dt_now());
+      rebase = false;
+    } else if (problem.empty() && holds.empty()) {
+      problem = energy_rise_problem(energy_now - energy_start, energy_limit, run.energy_name);
+    }
+    if (!problem.empty()) {
+      paused = true;
+      const std::string line = "live: frame " + std::to_string(frame) + ": " + problem + " (paused; reset to go on)";
+      std::fprintf(stderr, "%s\n", line.c_str());
+      server.send_text(-1, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", line}}.dump());
+    }
+    ++version;
+  };
+
+  auto send_frames = [&] {
+    if (!state.x.allFinite()) return;  // the last good frame stays on the page
+    std::vector<float> data;
+    std::string status;
+    for (const int client : server.ready_clients()) {
+      if (sent.count(client) && sent[client] == version) continue;
+      if (data.empty()) {
+        const std::size_t m = scene.springs.size();
+        data.reserve(3 * static_cast<std::size_t>(n) + m);
+        for (Eigen::Index p = 0; p < n; ++p) {
+          for (int a = 0; a < 3; ++a) data.push_back(static_cast<float>(state.x(a, p)));
+        }
+        for (const Spring& spring : scene.springs) data.push_back(static_cast<float>(signed_strain(state.x, spring)));
+        nlohmann::json values = nlohmann::json::object(), pinned = nlohmann::json::array(), held = nlohmann::json::array();
+        for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
+        for (Eigen::Index p = 0; p < n; ++p) {
+          if (state.inv_mass[p] <= 0.0 && !holds.count(static_cast<int>(p))) pinned.push_back(p);
+        }
+        for (const auto& [p, hold] : holds) {
+          held.push_back({{"particle", p}, {"x", {state.x(0, p), state.x(1, p), state.x(2, p)}}});
+        }
+        const double shown_energy = std::isfinite(energy_now) ? energy_now : 0.0;
+        status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
+                                {"previous_step_seconds", previous_step_seconds}, {"refactored", refactored},
+                                {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
+                                {"paused", paused}, {"speed", speed}, {"knobs", values}, {"pinned", pinned},
+                                {"held", held}, {"problem", problem}, {"clients", server.clients()}}
+                     .dump();
+      }
+      server.send_frame(client, status, data);
+      sent[client] = version;
+    }
+  };
+
+  while (!stop && !live_stop_requested) {
+    for (const LiveInbound& inbound : server.take_inbound()) apply(inbound);
+    if (stop) break;
+    const Clock::time_point now = Clock::now();
+    if (step_once || (!paused && problem.empty() && now >= next_due)) {
+      step_once = false;
+      refactored = false;
+      step();
+      const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(dt_now() / speed));
+      next_due += period;
+      if (next_due < Clock::now() - std::chrono::milliseconds(100)) next_due = Clock::now();
+    }
+    send_frames();
+    const double wait = paused ? 0.05 : std::chrono::duration<double>(next_due - Clock::now()).count();
+    server.wait_inbound(std::min(std::max(wait, 0.0), 0.05));
+  }
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGTERM, &old_term, nullptr);
+  for (auto& [p, hold] : holds) state.inv_mass[p] = hold.inv_mass;
+
+  std::printf("%s: live run ended after %d frames (%.3g s of simulated time, %.3e s per frame)\n", run.lab.c_str(),
+              steps_done, time, steps_done > 0 ? seconds / steps_done : 0.0);
+  if (!summary_path.empty()) {
+    RunSummary summary = stepping_summary(run.lab, run.method, scene, state, strain, seconds);
+    summary.steps = steps_done;
+    summary.dt = dt_now();
+    summary.extra["live"] = true;
+    summary.extra["frames"] = frame;
+    nlohmann::ordered_json values = nlohmann::ordered_json::object();
+    for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
+    summary.extra["knobs"] = values;
+    summary.extra["problem"] = problem;
+    write_summary(summary_path, summary);
+  }
+  return 0;
+}
+
+}  // namespace cl

@@ -1,0 +1,155 @@
+// The live mode's protocol (common/live_protocol.h, common/live_server.h's
+// token and Origin checks): every refusal is one line starting "live: " and
+// leaves the command empty; every accepted message carries its values.
+#include <catch2/catch.hpp>
+
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "common/live_protocol.h"
+#include "common/live_server.h"
+
+namespace {
+
+const cl::Knobs& lab04_knobs() {
+  static const cl::Knobs knobs{{"K", "sweeps", 0, 200, 10, true}, {"dt", "s", 1e-4, 0.05, 1.0 / 60.0, false}};
+  return knobs;
+}
+
+// The refusal of `text` on a 256-particle scene; it must name `expected`.
+void require_refused(const std::string& text, const std::string& expected) {
+  const cl::LiveParse parse = cl::parse_live_message(text, lab04_knobs(), 256);
+  CAPTURE(text, parse.error);
+  REQUIRE_FALSE(parse.ok());
+  CHECK(parse.error.rfind("live: ", 0) == 0);
+  CHECK(parse.error.find('\n') == std::string::npos);
+  CHECK(parse.error.find(expected) != std::string::npos);
+}
+
+cl::LiveCommand accepted(const std::string& text) {
+  const cl::LiveParse parse = cl::parse_live_message(text, lab04_knobs(), 256);
+  CAPTURE(text, parse.error);
+  REQUIRE(parse.ok());
+  return parse.command;
+}
+
+}  // namespace
+
+TEST_CASE("live protocol accepts every command with its values", "[live]") {
+  CHECK(accepted(R"({"cmd": "pause"})").kind == cl::LiveCommandKind::kPause);
+  CHECK(accepted(R"({"cmd": "resume"})").kind == cl::LiveCommandKind::kResume);
+  CHECK(accepted(R"({"cmd": "step"})").kind == cl::LiveCommandKind::kStep);
+  CHECK(accepted(R"({"cmd": "reset"})").kind == cl::LiveCommandKind::kReset);
+  CHECK(accepted(R"({"cmd": "stop"})").kind == cl::LiveCommandKind::kStop);
+  CHECK(accepted(R"({"cmd": "ack"})").kind == cl::LiveCommandKind::kAck);
+  const cl::LiveCommand speed = accepted(R"({"cmd": "speed", "value": 0.25})");
+  CHECK(speed.kind == cl::LiveCommandKind::kSpeed);
+  CHECK(speed.value == 0.25);
+  const cl::LiveCommand set = accepted(R"({"value": 32, "cmd": "set", "knob": "K"})");
+  CHECK(set.kind == cl::LiveCommandKind::kSet);
+  CHECK(set.knob == 0);
+  CHECK(set.value == 32.0);
+  CHECK(accepted(R"({"cmd": "set", "knob": "dt", "value": 1e-4})").knob == 1);
+  CHECK(accepted(R"({"cmd": "set", "knob": "K", "value": 200})").value == 200.0);  // the range's ends are in it
+  const cl::LiveCommand drag = accepted(R"({"cmd": "drag", "particle": 255, "x": [0.5, -1, 2e-3]})");
+  CHECK(drag.kind == cl::LiveCommandKind::kDrag);
+  CHECK(drag.particle == 255);
+  CHECK(drag.target == Eigen::Vector3d(0.5, -1.0, 2e-3));
+  CHECK(accepted(R"({"cmd": "release", "particle": 0})").particle == 0);
+  CHECK(accepted(R"({"cmd": "pin", "particle": 17})").kind == cl::LiveCommandKind::kPin);
+}
+
+TEST_CASE("live protocol refuses malformed JSON, a non-object and an unknown command", "[live]") {
+  require_refused(R"({"cmd": "pause")", "malformed JSON");
+  require_refused("", "malformed JSON");
+  require_refused(R"({"cmd": "pause"} trailing)", "malformed JSON");
+  require_refused(R"(["pause"])", "a JSON object");
+  require_refused(R"({"command": "pause"})", "no \"cmd\"");
+  require_refused(R"({"cmd": 3})", "no \"cmd\"");
+  require_refused(R"({"cmd": "explode"})", "unknown command 'explode'");
+  require_refused(R"({"cmd": "pause", "now": true})", "unknown key 'now'");
+  require_refused(R"({"cmd": "drag", "particle": 3})", "missing \"x\"");
+}
+
+TEST_CASE("live protocol refuses a knob out of its range, unknown or fractional for an integer knob", "[live]") {
+  require_refused(R"({"cmd": "set", "knob": "K", "value": 201})", "K: 201 is not in [0, 200]");
+  require_refused(R"({"cmd": "set", "knob": "K", "value": -1})", "is not in [0, 200]");
+  require_refused(R"({"cmd": "set", "knob": "K", "value": 2.5})", "K: 2.5 is not an integer");
+  require_refused(R"({"cmd": "set", "knob": "dt", "value": 0.5})", "dt: 0.5 is not in [0.0001, 0.05] s");
+  require_refused(R"({"cmd": "set", "knob": "omega", "value": 1})", "unknown knob 'omega'");
+  require_refused(R"({"cmd": "set", "knob": "K", "value": "8"})", "value: not a number");
+  require_refused(R"({"cmd": "speed", "value": 100})", "not in [0.01, 16]");
+  require_refused(R"({"cmd": "speed", "value": 0})", "not in [0.01, 16]");
+}
+
+TEST_CASE("live protocol refuses a particle index out of range or not an integer", "[live]") {
+  require_refused(R"({"cmd": "pin", "particle": 256})", "particle: 256 is not in [0, 255]");
+  require_refused(R"({"cmd": "pin", "particle": -1})", "particle: -1 is not in [0, 255]");
+  require_refused(R"({"cmd": "release", "particle": 18446744073709551615})", "is not in [0, 255]");
+  require_refused(R"({"cmd": "pin", "particle": 1.0})", "particle: not an integer");
+  require_refused(R"({"cmd": "drag", "particle": "0", "x": [0, 0, 0]})", "particle: not an integer");
+  const cl::LiveParse none = cl::parse_live_message(R"({"cmd": "pin", "particle": 0})", lab04_knobs(), 0);
+  CHECK_FALSE(none.ok());  // a scene with no particles has no index to give
+}
+
+TEST_CASE("live protocol refuses a non-finite number and a drag target out of reach", "[live]") {
+  // JSON has no NaN or inf literal, and nlohmann/json refuses a number too
+  // large for a double as a parse error: no message can carry a non-finite one.
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, 1e400, 0]})", "malformed JSON");
+  require_refused(R"({"cmd": "set", "knob": "dt", "value": -1e999})", "malformed JSON");
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, Infinity, 0]})", "malformed JSON");
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, NaN, 0]})", "malformed JSON");
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, 0]})", "x: not 3 numbers");
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, 0, null]})", "x: not a number");
+  require_refused(R"({"cmd": "drag", "particle": 0, "x": [0, 0, 2e4]})", "beyond 10000 m");
+}
+
+TEST_CASE("live protocol refuses a message over the size cap", "[live]") {
+  const std::string padded = R"({"cmd": "pause", "pad": ")" + std::string(cl::kLiveMessageCap, 'x') + "\"}";
+  require_refused(padded, "over the cap of 4096");
+  const std::string spaced = R"({"cmd": "pause")" + std::string(cl::kLiveMessageCap - 16, ' ') + "}";
+  REQUIRE(spaced.size() == cl::kLiveMessageCap);
+  CHECK(accepted(spaced).kind == cl::LiveCommandKind::kPause);  // exactly the cap is still a message
+}
+
+TEST_CASE("live knob declarations refuse a bad range and a repeated name and widen a range to the starting value", "[live]") {
+  CHECK_THROWS_AS((cl::Knobs{{"K", "", 0, 10, std::numeric_limits<double>::quiet_NaN(), false}}),
+                  std::invalid_argument);
+  const cl::Knobs widened{{"K", "", 0, 10, 11, true}, {"dt", "s", 1e-4, 0.05, 1e-5, false}};
+  CHECK(widened.all()[0].high == 11.0);  // a flag's value past the range widens it
+  CHECK(widened.all()[1].low == 1e-5);
+  CHECK_THROWS_AS((cl::Knobs{{"K", "", 10, 0, 5, true}}), std::invalid_argument);
+  CHECK_THROWS_AS((cl::Knobs{{"K", "", 0, 10, 2.5, true}}), std::invalid_argument);
+  CHECK_THROWS_AS((cl::Knobs{{"dt", "s", 0, std::numeric_limits<double>::infinity(), 1, false}}), std::invalid_argument);
+  CHECK_THROWS_AS((cl::Knobs{{"", "", 0, 1, 0, false}}), std::invalid_argument);
+  CHECK_THROWS_AS((cl::Knobs{{"K", "", 0, 1, 0, true}, {"K", "", 0, 1, 0, true}}), std::invalid_argument);
+  const cl::Knobs& knobs = lab04_knobs();
+  CHECK(knobs.integer(0) == 10);
+  CHECK(knobs[1] == 1.0 / 60.0);
+  CHECK(knobs.find("dt") == 1);
+  CHECK(knobs.find("k") == -1);
+  CHECK(knobs.json().find(R"("name":"K")") != std::string::npos);
+  CHECK(knobs.json().find(R"("integer":true)") != std::string::npos);
+}
+
+TEST_CASE("live server accepts only the run's token and its own Origin", "[live]") {
+  const std::string token = cl::live_token();
+  CHECK(token.size() == 32);
+  CHECK(token != cl::live_token());  // 128 random bits: two draws differ
+  CHECK(cl::live_token_matches(("token=" + token).c_str(), token));
+  CHECK(cl::live_token_matches(("a=1&token=" + token + "&b=2").c_str(), token));
+  CHECK_FALSE(cl::live_token_matches(nullptr, token));
+  CHECK_FALSE(cl::live_token_matches("", token));
+  CHECK_FALSE(cl::live_token_matches(("token=" + token + "x").c_str(), token));
+  CHECK_FALSE(cl::live_token_matches(("token=" + token.substr(1)).c_str(), token));
+  CHECK_FALSE(cl::live_token_matches(("xtoken=" + token).c_str(), token));
+  CHECK_FALSE(cl::live_token_matches("token=", ""));
+  CHECK(cl::live_origin_allowed(nullptr, 8123));
+  CHECK(cl::live_origin_allowed("http://127.0.0.1:8123", 8123));
+  CHECK(cl::live_origin_allowed("http://localhost:8123", 8123));
+  CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8124", 8123));
+  CHECK_FALSE(cl::live_origin_allowed("http://evil.example", 8123));
+  CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8123.evil.example", 8123));
+  CHECK_FALSE(cl::live_origin_allowed("null", 8123));
+}
