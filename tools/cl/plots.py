@@ -7,11 +7,14 @@ have just made their data). The terminal gets one line per figure drawn and one
 summary line for the rest; -v lists what was skipped and why.
 """
 import argparse
+import json
 import os
+import queue
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from . import grade
 from .base import ROOT, CourseError, show, under_root
@@ -19,7 +22,7 @@ from .labs import lab_dirs, resolve_lab
 
 PLOT_SKIPPED = 4  # a plot script's exit code when its input is not in DIR (plots/_figures.py)
 PLOT_ERROR_LINES = 12  # of a failing plot script's stderr, shown
-PLOT_WORKERS = 2  # scripts drawn at once (each is one single-threaded Python)
+PLOT_WORKERS = 2  # scripts drawn at once (each in a process forked from a runner, tools/cl/plot_worker.py)
 
 
 @dataclass
@@ -41,20 +44,54 @@ def plot_scripts(prefixes=None):
     return scripts
 
 
-def run_script(script, directory, force):
-    env = dict(os.environ, MPLBACKEND="Agg", CL_PLOTS_FORCE="1" if force else "0")
-    done = subprocess.run([sys.executable, str(script.relative_to(ROOT)), show(directory)],
-                          cwd=ROOT, env=env, capture_output=True, text=True, check=False)
-    said = [line for line in done.stdout.splitlines() if line.strip()]
+class PlotWorkers:
+    """PLOT_WORKERS runners (tools/cl/plot_worker.py), each with matplotlib
+    imported once; a script runs in a process forked from one, as it would
+    on its own. `run` may be called from PLOT_WORKERS threads at once."""
+
+    def __init__(self):
+        env = dict(os.environ, MPLBACKEND="Agg")
+        self.idle = queue.Queue()
+        self.processes = [subprocess.Popen([sys.executable, str(Path(__file__).with_name("plot_worker.py"))],
+                                           cwd=ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                           text=True) for _ in range(PLOT_WORKERS)]
+        for process in self.processes:
+            self.idle.put(process)
+
+    def run(self, script, directory, force):
+        """(exit code, stdout, stderr) of `python3 SCRIPT DIRECTORY`, run in a worker."""
+        process = self.idle.get()
+        try:
+            job = {"script": str(script.relative_to(ROOT)), "args": [show(directory)],
+                   "env": {"CL_PLOTS_FORCE": "1" if force else "0"}}
+            process.stdin.write(json.dumps(job) + "\n")
+            process.stdin.flush()
+            line = process.stdout.readline()
+            if not line:
+                return 1, "", f"the plot runner stopped (exit code {process.wait()})"
+            result = json.loads(line)
+            return result["code"], result["stdout"], result["stderr"]
+        finally:
+            self.idle.put(process)
+
+    def close(self):
+        for process in self.processes:
+            process.stdin.close()
+            process.wait()
+
+
+def run_script(workers, script, directory, force):
+    code, stdout, stderr = workers.run(script, directory, force)
+    said = [line for line in stdout.splitlines() if line.strip()]
     drawn = [line for line in said if line.startswith("wrote ")]
     current = [line.removeprefix("up to date: ") for line in said if line.startswith("up to date: ")]
-    if done.returncode == 0:
+    if code == 0:
         return PlotOutcome("ok", [], drawn, current)
-    if done.returncode == PLOT_SKIPPED:
+    if code == PLOT_SKIPPED:
         # The script's one line: the missing file and the command that makes it.
-        reason = [line for line in (done.stderr + done.stdout).splitlines() if line.strip()]
+        reason = [line for line in (stderr + stdout).splitlines() if line.strip()]
         return PlotOutcome("skipped", reason[:1], drawn, current)
-    error = [f"exit code {done.returncode}", *done.stderr.splitlines()[-PLOT_ERROR_LINES:]]
+    error = [f"exit code {code}", *stderr.splitlines()[-PLOT_ERROR_LINES:]]
     return PlotOutcome("failed", error, drawn, current)
 
 
@@ -64,9 +101,15 @@ def run_plots(directory, echo=True, names=None, prefixes=None, force=True, verbo
     line per figure drawn, every failure, and one line for what was skipped
     (with verbose: each skipped figure and script)."""
     scripts = [s for s in plot_scripts(prefixes) if names is None or s.name in names]
-    with ThreadPoolExecutor(max_workers=PLOT_WORKERS) as pool:
-        outcomes = dict(zip((s.name for s in scripts),
-                            pool.map(lambda script: run_script(script, directory, force), scripts)))
+    if not scripts:
+        return {}
+    workers = PlotWorkers()
+    try:
+        with ThreadPoolExecutor(max_workers=PLOT_WORKERS) as pool:
+            outcomes = dict(zip((s.name for s in scripts),
+                                pool.map(lambda script: run_script(workers, script, directory, force), scripts)))
+    finally:
+        workers.close()
     if echo:
         print_outcomes(outcomes, verbose)
     return outcomes
