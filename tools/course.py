@@ -13,6 +13,7 @@ from cl.checks import cmd_test
 from cl.demo import cmd_demo, cmd_run
 from cl.fuzz import cmd_fuzz
 from cl.grading import cmd_grade
+from cl.live import cmd_live
 from cl.measure import cmd_bench, cmd_extremes
 from cl.plots import cmd_plots
 from cl.release import cmd_release
@@ -37,6 +38,9 @@ usage: ./course COMMAND [ARGS]
                                      side in view-DIR-vs-DIR2.html beside DIR (DIR/view.html kept)
   run labNN [ARGS]                   one lab executable (your code); labNN_solution: the reference,
                                      where solutions/ holds it
+  live labNN [--port N] [ARGS]       the lab running live beside a page in the browser: drag the
+                                     cloth, pin it (shift-click), turn the knobs; prints the page's
+                                     URL (127.0.0.1 only); Ctrl-C or the page's stop ends it
   plots [labNN ...] [DIR] [-v]       the figures whose CSV/JSON in DIR (out/, or out/labNN_name)
                                      changed since drawn; -v: list the rest, --force: redraw all
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
@@ -49,7 +53,7 @@ Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "autograder": cmd_autograder, "view": cmd_view}
+            "release": cmd_release, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
 
 
 def main(argv):

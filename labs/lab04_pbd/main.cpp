@@ -11,6 +11,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/live.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -22,6 +23,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab04::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 // ------------------------------------------------------------------ one run
 
@@ -33,6 +35,20 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const cl::lab04::PbdSettings settings = cl::lab04::frame_settings(scene, options, lab, options.iterations);
+  if (live.on) {
+    cl::refuse_run_flags(options, "not with --live (the page shows every frame)", "");
+    cl::LiveRun run{kLab, options.method, {{"K", "sweeps", 0, 200, 1.0 * options.iterations, true},
+                                           {"dt", "s", 1e-4, 0.05, scene.dt},
+                                           {"substeps", "", 1, 64, 1.0 * lab.substeps, true}}};
+    run.step = [&](const cl::Knobs& knobs) {
+      cl::lab04::PbdSettings frame = settings;
+      frame.iterations = knobs.integer(0);
+      frame.dt = knobs[1];
+      cl::lab04::advance_frame(scene.particles, constraints, frame, knobs.integer(2));
+      return cl::StepVerdict{};
+    };
+    return cl::run_live(scene, live, run, options.summary);
+  }
   cl::lab04::RunPlan plan;
   plan.frames = scene.steps;
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
@@ -137,6 +153,7 @@ int main(int argc, char** argv) {
       .description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
                    "mesh into OUT/frames/");
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--substeps", lab.substeps, "PBD steps of dt/n per frame")
       .range(1, 1'000'000)
       .capture_default_str();

@@ -17,6 +17,7 @@ from .demo import index_links, run_demos, write_index, write_views
 from .fuzz import check_fuzz
 from .grading import Grader, write_results
 from .labs import lab_dirs, lab_targets, manifest, reject_lines
+from .live_checks import check_live
 from .measure import check_measurements
 from .plots import run_plots
 from .release import is_release
@@ -338,6 +339,8 @@ def cmd_test(argv):
     if "lab04_pbd" in labs and manifest()["lab04_pbd"]["reference"]:
         with checks.timed("the view in a browser (headless Chromium)"):
             check_browser(checks)
+        with checks.timed("the live page in a browser (headless Chromium)"):
+            check_live(checks)
     if not is_release():
         with checks.timed("student loop (a temporary release)"):
             check_student_loop(checks)

@@ -1,9 +1,85 @@
 // The player of ./course view (tools/cl/view.py inlines it after three.js and
 // OrbitControls, and the runs' data as <script id="runK"> (header JSON) and
-// <script id="binK"> (trajectory.bin, base64); docs/DESIGN.md §3).
+// <script id="binK"> (trajectory.bin, base64); docs/DESIGN.md §3). The live
+// page (tools/cl/live_page.html) inlines it too and draws with its shared
+// pieces, window.CLPlayer; the replay below runs only where runs are embedded.
 // Plain ES5 with the global THREE: ES modules do not load from file://.
 (function () {
   'use strict';
+
+  // Blue (compressed) through grey (0) to red (stretched), t in [-1, 1].
+  function strainColour(t, out, i) {
+    t = Math.max(-1, Math.min(1, t));
+    var grey = 0.55;
+    if (t >= 0) { out[i] = grey + (1 - grey) * t; out[i + 1] = grey * (1 - t); out[i + 2] = grey * (1 - t); }
+    else { t = -t; out[i] = grey * (1 - t); out[i + 1] = grey * (1 - t) + 0.2 * t; out[i + 2] = grey + (1 - grey) * t; }
+  }
+
+  // One run's three.js scene: springs coloured by strain, particles, pinned
+  // particles marked (room for `pinnedRoom`), triangles shaded.
+  // mesh = {particles: n, springs: [i, j, ...], triangles: [i, j, k, ...]}.
+  function makeRunScene(mesh, pinnedRoom) {
+    var n = mesh.particles, m = mesh.springs.length / 2;
+    var scene = new THREE.Scene();
+    scene.add(new THREE.AmbientLight(0xffffff, 0.55));
+    var light = new THREE.DirectionalLight(0xffffff, 0.6);
+    light.position.set(1, 2, 3);
+    scene.add(light);
+    var lines = new THREE.BufferGeometry();
+    lines.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * m), 3));
+    lines.setAttribute('color', new THREE.BufferAttribute(new Float32Array(6 * m), 3));
+    scene.add(new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ vertexColors: true })));
+    var points = new THREE.BufferGeometry();
+    points.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+    var pointSize = n > 2000 ? 1.5 : 3;
+    scene.add(new THREE.Points(points, new THREE.PointsMaterial({ color: 0x333333, size: pointSize, sizeAttenuation: false })));
+    var pinned = new THREE.BufferGeometry();
+    pinned.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * Math.max(pinnedRoom, 1)), 3));
+    pinned.setDrawRange(0, 0);
+    scene.add(new THREE.Points(pinned, new THREE.PointsMaterial({ color: 0xd08000, size: 9, sizeAttenuation: false })));
+    var surface = null;
+    if (mesh.triangles.length) {
+      surface = new THREE.BufferGeometry();
+      surface.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+      surface.setIndex(mesh.triangles);
+      scene.add(new THREE.Mesh(surface, new THREE.MeshLambertMaterial({
+        color: 0x8fb0d0, side: THREE.DoubleSide, transparent: true, opacity: 0.55,
+        polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 })));
+    }
+    return { scene: scene, lines: lines, points: points, pinnedPoints: pinned, surface: surface };
+  }
+
+  // One frame into a run's scene (makeRunScene's parts): positions x (3n, m),
+  // signed strains (one per spring) coloured over [−scale, scale], and the
+  // particles of pinnedList marked.
+  function setRunFrame(run, mesh, x, strain, scale, pinnedList) {
+    var m = mesh.springs.length / 2;
+    var lp = run.lines.attributes.position.array, lc = run.lines.attributes.color.array;
+    for (var e = 0; e < m; ++e) {
+      var i = mesh.springs[2 * e], j = mesh.springs[2 * e + 1];
+      for (var a = 0; a < 3; ++a) { lp[6 * e + a] = x[3 * i + a]; lp[6 * e + 3 + a] = x[3 * j + a]; }
+      strainColour(strain[e] / scale, lc, 6 * e);
+      lc[6 * e + 3] = lc[6 * e]; lc[6 * e + 4] = lc[6 * e + 1]; lc[6 * e + 5] = lc[6 * e + 2];
+    }
+    run.lines.attributes.position.needsUpdate = true;
+    run.lines.attributes.color.needsUpdate = true;
+    run.points.attributes.position.array.set(x);
+    run.points.attributes.position.needsUpdate = true;
+    var pp = run.pinnedPoints.attributes.position.array;
+    var marked = Math.min(pinnedList.length, pp.length / 3);
+    for (var q = 0; q < marked; ++q) { for (var b = 0; b < 3; ++b) pp[3 * q + b] = x[3 * pinnedList[q] + b]; }
+    run.pinnedPoints.setDrawRange(0, marked);
+    run.pinnedPoints.attributes.position.needsUpdate = true;
+    if (run.surface) {
+      run.surface.attributes.position.array.set(x);
+      run.surface.attributes.position.needsUpdate = true;
+      run.surface.computeVertexNormals();
+    }
+  }
+
+  window.CLPlayer = { strainColour: strainColour, makeRunScene: makeRunScene, setRunFrame: setRunFrame };
+  if (!document.getElementById('run0')) return;  // the live page: no replay
+
   var body = document.body;
   var runs = [];
   for (var r = 0; document.getElementById('run' + r); ++r) {
@@ -28,14 +104,6 @@
     return { x: x, strain: s };
   }
 
-  // Blue (compressed) through grey (0) to red (stretched), t in [-1, 1].
-  function strainColour(t, out, i) {
-    t = Math.max(-1, Math.min(1, t));
-    var grey = 0.55;
-    if (t >= 0) { out[i] = grey + (1 - grey) * t; out[i + 1] = grey * (1 - t); out[i + 2] = grey * (1 - t); }
-    else { t = -t; out[i] = grey * (1 - t); out[i + 1] = grey * (1 - t) + 0.2 * t; out[i + 2] = grey + (1 - grey) * t; }
-  }
-
   var renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
   renderer.setPixelRatio(window.devicePixelRatio || 1);
   renderer.setClearColor(0xf4f4f0);
@@ -46,7 +114,7 @@
   var lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
   var runScale = 0;
   runs.forEach(function (run) {
-    var h = run.header, n = h.particles, m = h.springs.length / 2;
+    var h = run.header;
     [0, h.frames.length - 1].forEach(function (k) {
       var f = h.frames[k];
       for (var a = 0; a < 3; ++a) {
@@ -55,36 +123,12 @@
       }
     });
     h.frames.forEach(function (f) { runScale = Math.max(runScale, f.strain_scale); });
-    var scene = new THREE.Scene();
-    scene.add(new THREE.AmbientLight(0xffffff, 0.55));
-    var light = new THREE.DirectionalLight(0xffffff, 0.6);
-    light.position.set(1, 2, 3);
-    scene.add(light);
-    var lines = new THREE.BufferGeometry();
-    lines.setAttribute('position', new THREE.BufferAttribute(new Float32Array(6 * m), 3));
-    lines.setAttribute('color', new THREE.BufferAttribute(new Float32Array(6 * m), 3));
-    scene.add(new THREE.LineSegments(lines, new THREE.LineBasicMaterial({ vertexColors: true })));
-    var points = new THREE.BufferGeometry();
-    points.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-    var pointSize = n > 2000 ? 1.5 : 3;
-    scene.add(new THREE.Points(points, new THREE.PointsMaterial({ color: 0x333333, size: pointSize, sizeAttenuation: false })));
-    var pinned = new THREE.BufferGeometry();
-    pinned.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * h.pinned.length), 3));
-    scene.add(new THREE.Points(pinned, new THREE.PointsMaterial({ color: 0xd08000, size: 9, sizeAttenuation: false })));
-    var surface = null;
-    if (h.triangles.length) {
-      surface = new THREE.BufferGeometry();
-      surface.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-      surface.setIndex(h.triangles);
-      scene.add(new THREE.Mesh(surface, new THREE.MeshLambertMaterial({
-        color: 0x8fb0d0, side: THREE.DoubleSide, transparent: true, opacity: 0.55,
-        polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 })));
-    }
-    run.scene = scene;
-    run.lines = lines;
-    run.points = points;
-    run.pinnedPoints = pinned;
-    run.surface = surface;
+    var parts = makeRunScene(h, h.pinned.length);
+    run.scene = parts.scene;
+    run.lines = parts.lines;
+    run.points = parts.points;
+    run.pinnedPoints = parts.pinnedPoints;
+    run.surface = parts.surface;
   });
 
   var camera = new THREE.PerspectiveCamera(40, 1, 1e-3, 1e4);
@@ -126,25 +170,7 @@
       var h = run.header, n = h.particles, m = h.springs.length / 2;
       var k = frameAt(run, time), f = h.frames[k], d = decode(run, k);
       var s = Math.max(scaleOf(scale, [f]), 1e-12);
-      var lp = run.lines.attributes.position.array, lc = run.lines.attributes.color.array;
-      for (var e = 0; e < m; ++e) {
-        var i = h.springs[2 * e], j = h.springs[2 * e + 1];
-        for (var a = 0; a < 3; ++a) { lp[6 * e + a] = d.x[3 * i + a]; lp[6 * e + 3 + a] = d.x[3 * j + a]; }
-        strainColour(d.strain[e] / s, lc, 6 * e);
-        lc[6 * e + 3] = lc[6 * e]; lc[6 * e + 4] = lc[6 * e + 1]; lc[6 * e + 5] = lc[6 * e + 2];
-      }
-      run.lines.attributes.position.needsUpdate = true;
-      run.lines.attributes.color.needsUpdate = true;
-      run.points.attributes.position.array.set(d.x);
-      run.points.attributes.position.needsUpdate = true;
-      var pp = run.pinnedPoints.attributes.position.array;
-      h.pinned.forEach(function (p, q) { for (var a = 0; a < 3; ++a) pp[3 * q + a] = d.x[3 * p + a]; });
-      run.pinnedPoints.attributes.position.needsUpdate = true;
-      if (run.surface) {
-        run.surface.attributes.position.array.set(d.x);
-        run.surface.attributes.position.needsUpdate = true;
-        run.surface.computeVertexNormals();
-      }
+      setRunFrame(run, h, d.x, d.strain, s, h.pinned);
       [0, Math.floor(n / 2), n - 1].forEach(function (p) {
         if (p >= 0) samples.push([r, p, d.x[3 * p], d.x[3 * p + 1], d.x[3 * p + 2]]);
       });
