@@ -75,6 +75,33 @@ std::optional<Contact> contact_of(const Collider& collider, const Eigen::Vector3
   return contact;
 }
 
+// Lab 07's Schur matrix Δt² J W Jᵀ + C, summed unknown by unknown: Δt² w_k
+// J_k J_kᵀ over each unknown's three columns J_k of J (a few springs each), so
+// that no sparse-sparse product is formed every step.
+SparseMatrix schur_matrix(const lab07::LinearizedStep& lin, double dt) {
+  const SparseMatrix& jacobian = lin.jacobian;
+  std::vector<Triplet> entries;
+  std::vector<std::pair<int, Eigen::Vector3d>> rows;  // the springs at one unknown and their 3 entries
+  for (Eigen::Index k = 0; 3 * k < jacobian.cols(); ++k) {
+    rows.clear();
+    for (int axis = 0; axis < 3; ++axis) {
+      for (SparseMatrix::InnerIterator it(jacobian, 3 * k + axis); it; ++it) {
+        const int row = static_cast<int>(it.row());
+        auto found = std::find_if(rows.begin(), rows.end(), [row](const auto& r) { return r.first == row; });
+        if (found == rows.end()) found = rows.insert(rows.end(), {row, Eigen::Vector3d::Zero()});
+        found->second[axis] = it.value();
+      }
+    }
+    const double scale = dt * dt * lin.inv_mass[3 * k];
+    for (const auto& [e, je] : rows) {
+      for (const auto& [f, jf] : rows) entries.emplace_back(e, f, scale * je.dot(jf));
+    }
+  }
+  for (Eigen::Index e = 0; e < lin.compliance.size(); ++e) entries.emplace_back(e, e, lin.compliance[e]);
+  for (Eigen::Index e = 0; e < jacobian.rows(); ++e) entries.emplace_back(e, e, 0.0);  // the full diagonal, always
+  return assemble(jacobian.rows(), jacobian.rows(), entries);
+}
+
 void check_settings(const StepSettings& settings) {
   if (!(std::isfinite(settings.dt) && settings.dt > 0.0)) {
     throw std::invalid_argument("ContactStepper: dt must be finite and > 0 (got " + std::to_string(settings.dt) + ")");
@@ -221,14 +248,7 @@ StepReport ContactStepper::constrained_step(Particles& particles) {
   StepReport report;
   if (with_springs) {
     lin = lab07::linearize(particles, springs_, map_, seven);
-    SparseMatrix a = (dt * dt) * (lin.jacobian * w.asDiagonal() * lin.jacobian.transpose());
-    if (lin.compliance.size() > 0) {
-      SparseMatrix c(a.rows(), a.cols());
-      std::vector<Triplet> entries;
-      for (Eigen::Index e = 0; e < lin.compliance.size(); ++e) entries.emplace_back(e, e, lin.compliance[e]);
-      c.setFromTriplets(entries.begin(), entries.end());
-      a += c;
-    }
+    const SparseMatrix a = schur_matrix(lin, dt);
     if (!schur.refactor(a)) {
       report.problem = "singular: the springs' Schur matrix is not positive definite (redundant hard springs?)";
       return report;
