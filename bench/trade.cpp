@@ -139,6 +139,8 @@ struct SceneInfo {
   double reference_seconds = 0, reference_strain = 0, displacement = 0, energy_scale = 0;
   int reference_constrained_iterations = 0, reference_iterations = 0, hard_iterations = 0;
   double hard_force_error = 0.0, hard_constraint_error = 0.0, hard_max_strain = 0.0, hard_seconds = 0.0;
+  int hard_newton_iterations = 0;
+  double hard_gradient = 0.0;  // ‖∇g‖∞ at k = 1e9 N/m at the hard step, N
   double hard_displacement = 0.0;  // RMS of the hard step's displacement, m (0: no hard step)
   double reference_constrained_gradient = 0.0, reference_gradient = 0.0;
 };
@@ -181,24 +183,116 @@ std::string time_text(double seconds) {
 }
 
 // The reference step from `start`: the minimiser of lab 06's objective g
-// (implicit Euler), found by lab 13's constrained Newton from the start (λ⁰
-// the springs' forces; compressed springs dropped from K_g, so that every
-// solve is lab 09's Schur solve: keeping them sent the 64² curtain's
-// iterations to lab 07's LU and left |∇g| at 3.5 N after 30) to |∇g| ≤ 1e-9 N
-// (on 64²: 4e-6 N after 8 iterations, then the dropped springs' linear tail,
-// a factor 0.8 per iteration, 39 in all), and then polished by Newton's
-// method with lab 06's gradient and (clamped) Hessian and a backtracking line
-// search, until the gradient stops halving. On 128² the constrained
-// iteration stops after 7 (no step length lowers its merit, 1.2e-3 N) and
-// the polish reaches 4e-4 N: short of 1e-8 N (bench/README.md). (Newton from
-// the prediction, as lab 06's step starts, needs hundreds of damped
-// iterations on the stiff 128² curtain; from 500 PD iterations, the earlier
-// start, 50 of them left |∇g| at 2e-3 N there.) Should the constrained
+// (implicit Euler). First lab 13's constrained Newton from the start (λ⁰ the
+// springs' forces; compressed springs dropped from K_g, so that every solve
+// is one Cholesky; no LU rescue) until |∇g| ≤ 1e-9 N (lab 06's gradient at
+// the iterate), no step length lowers its merit, or 100 iterations. Then
+// Newton's method on g with the EXACT Hessian (compressed springs' negative
+// transverse stiffness kept), shifted by τ M/Δt² with the smallest τ of
+// 0, 0.01, 0.02, 0.04, … that factors (τ starts at a quarter of the last
+// one, 0 below 1e-3), and a backtracking line search on g; once g cannot
+// tell a decrease from its round-off, the full step while the gradient
+// shrinks. It stops at |∇g| ≤ 1e-10 N, when the gradient stops shrinking at
+// round-off, or after 300 iterations, and keeps the iterate of the smallest
+// gradient. Why: on 128² g is not convex around the start (at 6e-5 kg a
+// particle, a spring compressed by 1e-7 of its length turns its transverse
+// block indefinite against M/Δt²), so lab 06's clamped Hessian, which sets
+// that curvature to 0, crawls along the buckling mode (|∇g| 2e-5 N after 170
+// iterations) and the dropped constrained iteration stalls at 1e-3 N; the
+// shifted exact Hessian follows the mode in ~50 iterations and then
+// converges quadratically (bench/README.md, run F). Should the constrained
 // iteration report a problem, 500 PD iterations start the polish instead.
+// Newton's method on lab 06's g from x (reference_step, above): the exact
+// Hessian shifted by τ M/Δt² (the smallest τ of 0, 0.01, 0.02, … that
+// factors), a backtracking line search on g, and at g's round-off the full
+// step while it shrinks the gradient; until |∇g| ≤ 1e-10 N, the gradient stops
+// shrinking at round-off, or 300 iterations. The iterate of the smallest
+// ‖∇g‖∞ is kept (start_gradient: x's own).
+struct Polish {
+  Eigen::Matrix3Xd x;
+  int iterations = 0;          // the polish iterations before the kept iterate
+  double gradient_norm = 0.0;  // ‖∇g‖∞ there, N
+};
+
+Polish newton_polish(const cl::lab06::Problem& problem, const Eigen::Matrix3Xd& y, Eigen::Matrix3Xd x,
+                     double start_gradient) {
+  cl::SpdFactorization factor;  // the backend for the size (common/sparse.h)
+  cl::lab06::HessianAssembly hessian(problem);
+  const cl::MovableMap& map = problem.map;
+  Eigen::VectorXd mass(3 * map.unknowns());  // M/Δt², stacked
+  for (int u = 0; u < map.unknowns(); ++u) {
+    mass.segment<3>(3 * u).setConstant(1.0 / (problem.inv_mass[map.particle_of[static_cast<std::size_t>(u)]] *
+                                              problem.dt * problem.dt));
+  }
+  double g = cl::lab06::objective(problem, x, y);
+  Eigen::Matrix3Xd best = x;
+  double best_gradient = start_gradient;
+  double tau = 0.0;
+  int taken = 0;
+  int best_iterations = 0;
+  for (int k = 1; k <= 300 && best_gradient > 1e-10; ++k) {
+    const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
+    const double gradient_norm = gradient.cwiseAbs().maxCoeff();
+    if (gradient_norm < best_gradient) {
+      best = x;
+      best_gradient = gradient_norm;
+      best_iterations = taken;
+    }
+    // The exact Hessian, shifted by τ M/Δt² until it factors.
+    tau = tau < 4e-3 ? 0.0 : 0.25 * tau;
+    const cl::SparseMatrix& exact = hessian.update(problem, x, false);
+    bool factored = false;
+    for (int attempt = 0; attempt < 40 && !factored; ++attempt) {
+      if (attempt > 0) tau = tau == 0.0 ? 1e-2 : 2.0 * tau;  // τ: 0, 0.01, 0.02, 0.04, …
+      cl::SparseMatrix matrix = exact;
+      if (tau > 0.0) {
+        for (Eigen::Index r = 0; r < matrix.rows(); ++r) matrix.coeffRef(r, r) += tau * mass[r];
+      }
+      factored = factor.refactor(matrix);
+    }
+    if (!factored && !factor.refactor(hessian.update(problem, x, true))) break;
+    const Eigen::VectorXd step = factor.solve(-gradient);
+    const double slope = gradient.dot(step);
+    auto moved = [&](double alpha) {
+      Eigen::Matrix3Xd trial = x;
+      for (int u = 0; u < map.unknowns(); ++u) {
+        trial.col(map.particle_of[static_cast<std::size_t>(u)]) += alpha * step.segment<3>(3 * u);
+      }
+      return trial;
+    };
+    // At round-off g cannot tell a better x from a worse one (its predicted
+    // decrease is below a few ulps of g): the full step while it shrinks the
+    // gradient, as lab 06's Newton does.
+    if (!(slope < 0.0) || -slope <= 64.0 * std::numeric_limits<double>::epsilon() * std::abs(g)) {
+      const Eigen::Matrix3Xd trial = moved(1.0);
+      if (cl::lab06::newton_gradient(problem, trial, y).cwiseAbs().maxCoeff() >= gradient_norm) break;
+      x = trial;
+    } else {
+      double alpha = 1.0;
+      bool accepted = false;
+      for (int halving = 0; halving < 40 && !accepted; ++halving, alpha *= 0.5) {
+        const Eigen::Matrix3Xd trial = moved(alpha);
+        accepted = cl::lab06::objective(problem, trial, y) <= g + 1e-4 * alpha * slope;
+        if (accepted) x = trial;
+      }
+      if (!accepted) break;
+    }
+    ++taken;
+    g = cl::lab06::objective(problem, x, y);
+  }
+  const double last_gradient = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
+  if (last_gradient < best_gradient) {
+    best = x;
+    best_gradient = last_gradient;
+    best_iterations = taken;
+  }
+  return {best, best_iterations, best_gradient};
+}
+
 struct Reference {
   cl::Particles after;
   int constrained_iterations = 0;  // lab 13's, -1 when PD started the polish
-  Eigen::VectorXd lambda;          // lab 13's multipliers at its last iterate (empty when PD started)
+  Eigen::VectorXd lambda;          // the springs' forces −kφ at the result (empty when PD started)
   int newton_iterations = 0;
   double constrained_gradient_norm = 0.0;  // ‖∇g‖∞ after lab 13's iterations, N
   double gradient_norm = 0.0;  // ‖∇g‖∞ at the result, N
@@ -212,13 +306,16 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
   const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
   ref.after = start;
   Eigen::Matrix3Xd x = start.x;
+  std::vector<cl::Spring> movable_springs;  // lab 13's: without the springs between two pins
   {
     const cl::lab13::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+    movable_springs = solver.springs();
     cl::lab13::Settings settings;
     settings.gravity = scene.gravity;
     settings.iterations = 100;
     settings.tolerance = 0.0;
     settings.compression = cl::lab09::Compression::kDrop;
+    settings.exact_rescue = false;
     Eigen::VectorXd lambda = cl::lab13::warm_start(start.x, solver.springs(), {}, cl::lab13::Warm::kForces);
     // Until |∇g| ≤ 1e-9 N (lab 06's gradient at the iterate), no step length
     // lowers the merit, or 100 iterations.
@@ -238,62 +335,14 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
     }
   }
   ref.constrained_gradient_norm = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
-  cl::SpdFactorization factor;  // the backend for the size (common/sparse.h)
-  cl::lab06::HessianAssembly hessian(problem);
-  double g = cl::lab06::objective(problem, x, y);
-  // The polish keeps the iterate of the smallest gradient and ends once an
-  // iteration no longer halves it (round-off).
-  Eigen::Matrix3Xd best = x;
-  double best_gradient = ref.constrained_gradient_norm;
-  int taken = 0;
-  for (int k = 1; k <= 50; ++k) {
-    const Eigen::VectorXd gradient = cl::lab06::newton_gradient(problem, x, y);
-    if (k > 1) {
-      const double gradient_norm = gradient.cwiseAbs().maxCoeff();
-      const bool shrinking = gradient_norm <= 0.5 * best_gradient;
-      if (gradient_norm < best_gradient) {
-        best = x;
-        best_gradient = gradient_norm;
-        ref.newton_iterations = taken;
-      }
-      if (!shrinking) break;
-    }
-    if (!factor.refactor(hessian.update(problem, x))) break;
-    const Eigen::VectorXd step = factor.solve(-gradient);
-    const double slope = gradient.dot(step);
-    double alpha = 1.0;
-    Eigen::Matrix3Xd trial = x;
-    bool accepted = false;
-    for (int halving = 0; halving < 40 && !accepted; ++halving, alpha *= 0.5) {
-      trial = x;
-      for (int u = 0; u < problem.map.unknowns(); ++u) {
-        trial.col(problem.map.particle_of[static_cast<std::size_t>(u)]) += alpha * step.segment<3>(3 * u);
-      }
-      accepted = cl::lab06::objective(problem, trial, y) <= g + 1e-4 * alpha * slope;
-    }
-    // At round-off the objective cannot tell a better x from a worse one:
-    // take the full step while it keeps shrinking, as lab 06's Newton does.
-    const double length = step.cwiseAbs().maxCoeff();
-    if (!accepted) {
-      if (length > 1e-9 * std::max(1.0, x.cwiseAbs().maxCoeff())) break;
-      for (int u = 0; u < problem.map.unknowns(); ++u) {
-        x.col(problem.map.particle_of[static_cast<std::size_t>(u)]) += step.segment<3>(3 * u);
-      }
-    } else {
-      x = trial;
-    }
-    ++taken;
-    g = cl::lab06::objective(problem, x, y);
-    if (length <= 64.0 * std::numeric_limits<double>::epsilon() * x.cwiseAbs().maxCoeff()) break;
-  }
-  const double last_gradient = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
-  if (last_gradient < best_gradient) {
-    best = x;
-    best_gradient = last_gradient;
-    ref.newton_iterations = taken;
-  }
-  x = best;
+  const Polish polish = newton_polish(problem, y, x, ref.constrained_gradient_norm);
+  ref.newton_iterations = polish.iterations;
+  const double best_gradient = polish.gradient_norm;
+  x = polish.x;
   ref.gradient_norm = best_gradient;
+  // The hard step starts from the springs' forces at the result (the polish
+  // may have moved it far from the constrained iteration's λ).
+  if (ref.lambda.size() != 0) ref.lambda = cl::lab13::warm_start(x, movable_springs, {}, cl::lab13::Warm::kForces);
   for (Eigen::Index p = 0; p < x.cols(); ++p) {
     ref.after.v.col(p) = start.inv_mass[p] > 0.0 ? Eigen::Vector3d((x.col(p) - start.x.col(p)) / scene.dt)
                                                  : Eigen::Vector3d::Zero();
@@ -308,17 +357,25 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
 // shear springs are a redundant set (lab 07's KKT matrix is singular there,
 // lab 13 reports it), so the step is taken at k = 1e9 N/m (C = 1e-9 m/N), a
 // thousand times the scene's k: its strain, of order m g / k, is 1e-3 of the
-// k step's. Lab 13's constrained Newton from the k step's x and λ, compressed
-// springs kept (dropped, or at k = 1e10 N/m and more, it stalls on 32² and
-// 64²), until its constraint error (max |φ + Cλ| over the mean rest length)
-// is ≤ 1e-12 and its force error ≤ 1e-9; not converged within 30 iterations
-// or 30 s, the scene has no hard step (relative_distance_hard NaN).
+// k step's. Lab 13's constrained Newton from the k step's x and its springs'
+// forces, compressed springs kept (dropped, or at k = 1e10 N/m and more, it
+// stalls on 32² and 64²; no LU rescue), until its constraint error (max
+// |φ + Cλ| over the mean rest length) is ≤ 1e-12 and its force error ≤ 1e-9,
+// at most 30 iterations or 30 s. Where it does not get there (128²: the same
+// non-convexity as the k step's, every iteration damped to α = 2⁻¹⁰), the
+// reference step's Newton polish on g at k = 1e9 N/m takes over (from the
+// constrained iteration's end or the k step, whichever has the smaller
+// gradient), and the step counts when its |∇g| is ≤ 1e-6 N (the constrained
+// route's force error 1e-9 is about 1e-8 N; round-off in g's gradient grows
+// with k). Otherwise the scene has no hard step (relative_distance_hard NaN).
 constexpr double kHardStiffness = 1e9;  // N/m
 
 struct HardStep {
   Eigen::Matrix3Xd x;  // empty when it failed
-  int iterations = 0;
+  int iterations = 0;         // lab 13's
+  int newton_iterations = 0;  // the polish's (0: not needed)
   double force_error = 0.0, constraint_error = 0.0, max_strain = 0.0, seconds = 0.0;
+  double gradient_norm = 0.0;  // ‖∇g‖∞ of lab 06's objective at k = 1e9 N/m at the result, N
   std::string problem;
 };
 
@@ -337,6 +394,7 @@ HardStep hard_step(const cl::Scene& scene, const cl::Particles& start, const Ref
   settings.iterations = 30;
   settings.tolerance = 0.0;
   settings.compression = cl::lab09::Compression::kKeep;
+  settings.exact_rescue = false;
   const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
   Eigen::Matrix3Xd x = reference.after.x;
   Eigen::VectorXd lambda = reference.lambda;
@@ -350,15 +408,31 @@ HardStep hard_step(const cl::Scene& scene, const cl::Particles& start, const Ref
   hard.force_error = report.force_error;
   hard.constraint_error = report.constraint_error;
   hard.problem = report.problem;
+  const cl::lab06::Problem problem = cl::lab06::make_problem(scene.particles.inv_mass, springs, scene.dt);
   if (hard.problem.empty() && !converged) {
-    char text[160];
-    std::snprintf(text, sizeof text, "not converged after %d iterations (force error %.1e, constraint error %.1e)",
-                  report.iterations_done, report.force_error, report.constraint_error);
-    hard.problem = text;
+    // From the better of the constrained iteration's end and the k step.
+    const double at_end = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
+    const double at_k = cl::lab06::newton_gradient(problem, reference.after.x, y).cwiseAbs().maxCoeff();
+    const Polish polish = at_end <= at_k ? newton_polish(problem, y, x, at_end)
+                                         : newton_polish(problem, y, reference.after.x, at_k);
+    hard.newton_iterations = polish.iterations;
+    if (polish.gradient_norm <= 1e-6) {
+      x = polish.x;
+      converged = true;
+    } else {
+      char text[200];
+      std::snprintf(text, sizeof text,
+                    "not converged after %d iterations (force error %.1e, constraint error %.1e), nor the Newton "
+                    "polish (|grad g| %.1e N after %d)",
+                    report.iterations_done, report.force_error, report.constraint_error, polish.gradient_norm,
+                    polish.iterations);
+      hard.problem = text;
+    }
   }
   if (hard.problem.empty()) {
     hard.x = x;
     hard.max_strain = cl::strain_stats(x, scene.springs).max;
+    hard.gradient_norm = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
   }
   hard.seconds = timer.seconds();
   return hard;
@@ -455,14 +529,16 @@ int run(const Options& options) {
     info.hard_constraint_error = hard.constraint_error;
     info.hard_max_strain = hard.max_strain;
     info.hard_seconds = hard.seconds;
+    info.hard_newton_iterations = hard.newton_iterations;
+    info.hard_gradient = hard.gradient_norm;
     if (hard.x.cols() == start.x.cols()) info.hard_displacement = rms_distance(hard.x, start.x);
     infos.push_back(info);
     progress.clear();
     if (info.hard_displacement > 0.0) {
       std::printf("%-12s hard step (k = %.0e N/m, constrained newton %d iterations, force error %.1e, constraint "
-                  "error %.1e, %s)\n",
+                  "error %.1e, then newton %d; |grad g| %.1e N, %s)\n",
                   scene.name.c_str(), kHardStiffness, info.hard_iterations, info.hard_force_error, info.hard_constraint_error,
-                  time_text(info.hard_seconds).c_str());
+                  info.hard_newton_iterations, info.hard_gradient, time_text(info.hard_seconds).c_str());
     } else {
       std::printf("%-12s hard step not computed: %s\n", scene.name.c_str(), hard.problem.c_str());
     }
@@ -576,7 +652,8 @@ int run(const Options& options) {
                             "reference_constrained_gradient_norm", "reference_newton_iterations", "reference_gradient_norm",
                             "reference_seconds", "reference_max_strain", "step_displacement_rms", "energy_scale",
                             "hard_iterations", "hard_force_error", "hard_constraint_error", "hard_max_strain",
-                            "hard_seconds", "hard_displacement_rms"});
+                            "hard_seconds", "hard_displacement_rms", "hard_newton_iterations",
+                            "hard_gradient_norm"});
   for (const SceneInfo& info : infos) {
     scene_table.add_row({info.name, info.particles, info.springs, options.stiffness, 1.0 / 60.0,
                          static_cast<long long>(warmup), static_cast<long long>(info.reference_constrained_iterations),
@@ -584,7 +661,8 @@ int run(const Options& options) {
                          info.reference_gradient,
                          info.reference_seconds, info.reference_strain, info.displacement, info.energy_scale,
                          static_cast<long long>(info.hard_iterations), info.hard_force_error, info.hard_constraint_error,
-                         info.hard_max_strain, info.hard_seconds, info.hard_displacement});
+                         info.hard_max_strain, info.hard_seconds, info.hard_displacement,
+                         static_cast<long long>(info.hard_newton_iterations), info.hard_gradient});
   }
   scene_table.write(cl::join_path(options.out, "trade_scenes.csv"));
 

@@ -254,7 +254,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       }
     };
     bool accepted = line_search(solution);
-    if (!accepted && !exact && schur) {
+    if (!accepted && !exact && schur && settings.exact_rescue) {
       // Only the exact Newton direction is sure to lower ψ (ψ'(0) = −2ψ): the
       // dropped one found no step length, so this iteration takes lab 07's
       // KKT solve (an LU) of the exact, indefinite system instead.

@@ -44,6 +44,12 @@ struct Settings {
   // always dropped (kDrop: always definite, but a slow linear tail).
   lab09::Compression compression = lab09::Compression::kKeep;
   int max_backtracks = 12;   // halvings of α before the step gives up (α ≥ 2⁻¹²)
+  // A dropped direction (Compression::kDrop, or a fallback) that lowers ψ for
+  // no α: true, the iteration takes lab 07's KKT solve of the exact system
+  // (StepReport::exact_rescues); false, the step stops there (a failed
+  // decrease). The bench's reference step turns it off: on its 128² curtain
+  // the LU costs 15 s an iteration and its damped steps do not get closer.
+  bool exact_rescue = true;
 };
 
 struct IterationRecord {
