@@ -112,6 +112,9 @@ int run_incline(const char* lab_name, const CommonOptions& options, const LabOpt
   refuse_run_flags(options, "--incline writes incline.csv, not one run's trajectory",
                    "--incline writes incline.csv, not one run's summary");
   if (lab.friction) throw InputError("--friction: --incline sweeps --frictions instead");
+  if (options.scene != kDefaultScene) throw InputError("--scene: --incline builds its own scenes (incline_scene)");
+  if (options.steps >= 0) throw InputError("--steps: --incline takes 100 steps of 1/60 s");
+  if (options.dt > 0.0) throw InputError("--dt: --incline takes 100 steps of 1/60 s");
   const std::vector<double>& angles = lab.angles.empty() ? kAngles : lab.angles;
   for (std::size_t a = 0; a < angles.size(); ++a) {
     if (!(angles[a] > 0.0 && angles[a] < 90.0)) {

@@ -20,6 +20,9 @@ struct LabOptions {
   std::vector<double> angles;                     // --angles, degrees (empty: kAngles)
 };
 
+// The driver's default --scene.
+inline constexpr const char* kDefaultScene = "drape-sphere";
+
 // The experiments' defaults: μ ∈ {0, 0.3, 1} (--drape, --incline), and θ in
 // degrees around atan 0.3 = 16.70° and atan 1 = 45° (--incline).
 inline const std::vector<double> kFrictions{0.0, 0.3, 1.0};
@@ -50,7 +53,8 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
 // less than 1e-12 m along the slope), its acceleration along the slope (from
 // the velocity after 100 steps) and Coulomb's g (sin θ − μ cos θ) ->
 // OUT/incline.csv, and per method and μ the largest θ that sticks against
-// atan μ on the terminal.
+// atan μ on the terminal. Both experiments run every method (--method is not
+// read); --incline refuses --scene, --steps and --dt (it builds its own).
 int run_incline(const char* lab_name, const CommonOptions& options, const LabOptions& lab);
 
 }  // namespace cl::lab14

@@ -76,7 +76,7 @@ int main(int argc, char** argv) {
       "Lab 14: contact with planes, spheres and capsules, with Coulomb friction, by PBD, XPBD or the constrained "
       "step with projected Gauss-Seidel. Runs a scene, or one of the experiments (--drape, --incline).",
       CL_PROGRAM_NAME};
-  cl::CommonOptions options = cl::lab_defaults("drape-sphere", "pbd", {"pbd", "xpbd", "constrained"});
+  cl::CommonOptions options = cl::lab_defaults(cl::lab14::kDefaultScene, "pbd", {"pbd", "xpbd", "constrained"});
   options.iterations = 10;
   options.models_colliders = true;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
