@@ -4,9 +4,10 @@
 // al., "Position Based Dynamics" (2007), §3.3 and §3.5 (collision constraints
 // generated per step, projected like any other); Macklin, Müller, Chentanez and
 // Kim, "Unified Particle Physics for Real-Time Applications" (2014), §6.1,
-// eqs. (24)–(25) (position-based friction); Anitescu and Potra (1997) and
-// Erleben, "Velocity-based shock propagation…" (2007), for contact rows
-// solved by projected Gauss-Seidel on the Schur complement.
+// eqs. (24)–(25) (position-based friction); Anitescu and Potra (1997), the
+// velocity-level contact step, and Erleben, "Numerical methods for linear
+// complementarity problems in physics-based animation" (SIGGRAPH course,
+// 2013), projected Gauss-Seidel on the Schur complement.
 //
 // Units: positions in m, velocities in m/s, inverse masses in 1/kg (0 =
 // pinned), time in s, multipliers λ in N (lab 07's convention: the contact's
