@@ -9,6 +9,7 @@
 // page's "stop", then writes --summary (when given) and returns 0.
 #include <functional>
 #include <string>
+#include <utility>
 
 #include "common/cli.h"
 #include "common/frame_loop.h"
@@ -27,6 +28,8 @@ void add_live_option(CommandLine& line, LiveOptions& live);
 
 // What a lab gives the live loop.
 struct LiveRun {
+  LiveRun(std::string lab_name, std::string method_name, Knobs declared)
+      : lab(std::move(lab_name)), method(std::move(method_name)), knobs(std::move(declared)) {}
   std::string lab;
   std::string method;
   // The knobs the page turns. A knob named "dt" is the step (s): the loop's

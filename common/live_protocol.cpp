@@ -29,6 +29,16 @@ const std::vector<std::pair<const char*, std::vector<const char*>>>& live_comman
 }
 
 // A finite number from `value`, or the reason it is not one.
+// A name from the message, as an error line may quote it: at most 40 bytes,
+// control characters (a "\n" in a JSON string) as '?', so the line stays one line.
+std::string quoted(const std::string& text) {
+  std::string shown = text.substr(0, 40);
+  for (char& c : shown) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  return "'" + shown + "'";
+}
+
 std::string read_finite(const nlohmann::json& value, const char* key, double& out) {
   if (!value.is_number()) return std::string(key) + ": not a number";
   out = value.get<double>();
@@ -112,13 +122,13 @@ LiveParse parse_live_message(const std::string& text, const Knobs& knobs, long l
       break;
     }
   }
-  if (fields == nullptr) return refuse("unknown command '" + name.substr(0, 40) + "'");
+  if (fields == nullptr) return refuse("unknown command " + quoted(name));
   parse.command.kind = static_cast<LiveCommandKind>(kind);
   for (const auto& item : message.items()) {
     if (item.key() == "cmd") continue;
     bool known = false;
     for (const char* field : *fields) known = known || item.key() == field;
-    if (!known) return refuse(name + ": unknown key '" + item.key().substr(0, 40) + "'");
+    if (!known) return refuse(name + ": unknown key " + quoted(item.key()));
   }
   for (const char* field : *fields) {
     if (!message.contains(field)) return refuse(name + ": missing \"" + field + "\"");
@@ -137,7 +147,7 @@ LiveParse parse_live_message(const std::string& text, const Knobs& knobs, long l
       if (!message["knob"].is_string()) return refuse("set: knob: not a string");
       const std::string knob = message["knob"].get<std::string>();
       command.knob = knobs.find(knob);
-      if (command.knob < 0) return refuse("set: unknown knob '" + knob.substr(0, 40) + "'");
+      if (command.knob < 0) return refuse("set: unknown knob " + quoted(knob));
       const Knob& declared = knobs.all()[static_cast<std::size_t>(command.knob)];
       problem = read_finite(message["value"], "value", command.value);
       if (problem.empty() && !(command.value >= declared.low && command.value <= declared.high)) {

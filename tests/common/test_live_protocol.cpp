@@ -3,7 +3,10 @@
 // leaves the command empty; every accepted message carries its values.
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -70,6 +73,8 @@ TEST_CASE("live protocol refuses malformed JSON, a non-object and an unknown com
   require_refused(R"({"cmd": "explode"})", "unknown command 'explode'");
   require_refused(R"({"cmd": "pause", "now": true})", "unknown key 'now'");
   require_refused(R"({"cmd": "drag", "particle": 3})", "missing \"x\"");
+  require_refused(R"({"cmd": "line\nbreak"})", "unknown command 'line?break'");  // still one line
+  require_refused(R"({"cmd": "pause", "a\u0000b": 1})", "unknown key 'a?b'");
 }
 
 TEST_CASE("live protocol refuses a knob out of its range, unknown or fractional for an integer knob", "[live]") {
@@ -152,4 +157,22 @@ TEST_CASE("live server accepts only the run's token and its own Origin", "[live]
   CHECK_FALSE(cl::live_origin_allowed("http://evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8123.evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("null", 8123));
+}
+
+// Inputs the fuzzer (fuzz/fuzz_live.cpp) found to break the parser, kept in
+// tests/common/live_regressions/: each must now parse or be refused in one line.
+TEST_CASE("live protocol replays the fuzzer's saved inputs", "[live]") {
+  const std::filesystem::path folder = std::filesystem::path(CL_SOURCE_DIR) / "tests/common/live_regressions";
+  int replayed = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    if (entry.path().filename() == "README.md") continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    const cl::LiveParse parse = cl::parse_live_message(text.str(), lab04_knobs(), 256);
+    CAPTURE(entry.path().string(), parse.error);
+    CHECK((parse.ok() || (parse.error.rfind("live: ", 0) == 0 && parse.error.find('\n') == std::string::npos)));
+    ++replayed;
+  }
+  CHECK(replayed >= 1);  // the folder holds at least its seed
 }

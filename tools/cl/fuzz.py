@@ -1,4 +1,5 @@
-"""./course fuzz: the scene loader under libFuzzer (fuzz/, clang), and its CI check."""
+"""./course fuzz: the scene loader and the live mode's message parser under
+libFuzzer (fuzz/, clang), and its CI check."""
 import argparse
 import shutil
 import subprocess
@@ -10,10 +11,19 @@ from .base import BUILD, ROOT, CourseError, show
 from .build import BuildFailure, build_targets, generator_args, quiet
 
 REGRESSIONS = ROOT / "tests" / "common" / "scene_regressions"
+LIVE_REGRESSIONS = ROOT / "tests" / "common" / "live_regressions"
+# Each target: its seeds (besides its saved inputs), dictionary, regression
+# folder and share of the fuzzing time. The scene loader has the larger input
+# space and keeps most of it; the live parser's messages are short.
+TARGETS = {
+    "fuzz_scene": (lambda: ROOT.glob("labs/*/scenes/*.json"), ROOT / "fuzz" / "scene.dict", REGRESSIONS, 0.75),
+    "fuzz_live": (lambda: [], ROOT / "fuzz" / "live.dict", LIVE_REGRESSIONS, 0.25),
+}
 
 
 def build_fuzzer(log=sys.stdout):
-    """Build fuzz/ with clang++ into BUILD/fuzz; return the fuzz_scene program."""
+    """Build fuzz/ with clang++ into BUILD/fuzz; return the fuzz_scene program
+    (fuzz_live beside it)."""
     fuzz_build = BUILD / "fuzz"
     if shutil.which("clang++") is None:
         raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
@@ -21,35 +31,49 @@ def build_fuzzer(log=sys.stdout):
         quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), *generator_args(fuzz_build),
                "-DCMAKE_CXX_COMPILER=clang++",
                "-DCMAKE_BUILD_TYPE=RelWithDebInfo"], "configure fuzz/")
-    build_targets(["fuzz_scene"], build_dir=fuzz_build, log=log)
+    build_targets(list(TARGETS), build_dir=fuzz_build, log=log)
     return fuzz_build / "fuzz_scene"
 
 
-def fuzz(program, seconds):
-    """Fuzz the scene loader with PROGRAM (build_fuzzer's) for SECONDS, on one core,
-    starting from every shipped scene and saved regression input, with the scene
-    format's dictionary. A crashing input is copied into tests/common/scene_regressions/.
-    Return (ok, last lines of libFuzzer's output, the copied inputs)."""
+def fuzz_one(program, seconds):
+    """Fuzz with PROGRAM (a target of TARGETS, built) for SECONDS on one core,
+    from its seeds and saved inputs, with its dictionary. A crashing input is
+    copied into the target's regression folder. (ok, libFuzzer's last lines, copied inputs)."""
+    seeds, dictionary, regressions, _ = TARGETS[program.name]
     fuzz_build = program.parent
-    corpus = fuzz_build / "corpus"
+    suffix = "" if program.name == "fuzz_scene" else f"-{program.name}"  # the scene fuzzer's folders as before
+    corpus = fuzz_build / f"corpus{suffix}"
     corpus.mkdir(exist_ok=True)
-    seeds = [*ROOT.glob("labs/*/scenes/*.json"), *(p for p in REGRESSIONS.glob("*") if p.name != "README.md")]
-    for seed in seeds:
+    for seed in [*seeds(), *(p for p in regressions.glob("*") if p.name != "README.md")]:
         shutil.copy(seed, corpus / f"seed-{seed.name}")
-    artifacts = fuzz_build / "crashes"
+    artifacts = fuzz_build / f"crashes{suffix}"
     shutil.rmtree(artifacts, ignore_errors=True)
     artifacts.mkdir()
     done = subprocess.run([str(program), f"-max_total_time={seconds}", "-rss_limit_mb=2048",
-                           "-max_len=4096", f"-dict={ROOT / 'fuzz' / 'scene.dict'}",
-                           f"-artifact_prefix={artifacts}/", str(corpus)],
+                           "-max_len=4096" if program.name == "fuzz_scene" else "-max_len=5000",
+                           f"-dict={dictionary}", f"-artifact_prefix={artifacts}/", str(corpus)],
                           cwd=fuzz_build, capture_output=True, text=True, check=False)
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     kept = []
     for artifact in sorted(artifacts.iterdir()):
-        target = REGRESSIONS / artifact.name
+        target = regressions / artifact.name
         shutil.copy(artifact, target)
         kept.append(target)
     return done.returncode == 0, lines[-12:], kept
+
+
+def fuzz(program, seconds):
+    """Fuzz every target of TARGETS (PROGRAM, build_fuzzer's, and the others beside
+    it) one after the other, SECONDS in all, split by their shares. Return (ok,
+    the last lines of each run's output, the copied inputs)."""
+    ok, lines, kept = True, [], []
+    for name, (_, _, _, share) in TARGETS.items():
+        one_ok, one_lines, one_kept = fuzz_one(program.parent / name, max(1, round(seconds * share)))
+        ok = ok and one_ok
+        shown = one_lines if not one_ok else [line for line in one_lines if line.startswith("Done ")][-1:]
+        lines += [f"{name}: {line}" for line in shown]
+        kept += one_kept
+    return ok, lines, kept
 
 
 def run_fuzz(seconds, log=sys.stdout):
@@ -69,7 +93,7 @@ def cmd_fuzz(argv):
         return 0
     for path in kept:
         print(f"fuzz: a crashing input, kept as a regression test: {show(path)}")
-    print("fuzz: fix the loader until ./course test passes, then commit the input with the fix")
+    print("fuzz: fix the loader (or the live parser) until ./course test passes, then commit the input with the fix")
     return 1
 
 
@@ -97,7 +121,8 @@ def check_fuzz(checks, seconds=60):
         finally:
             pool.shutdown()
             checks.add_time(f"fuzz: {seconds} s run", time.monotonic() - started)
-        runs = next((line for line in reversed(lines) if line.startswith("Done ")), "")
+        runs = "; ".join(line for line in lines if "Done " in line)
         details = [] if ok else [*lines, *(f"kept as a regression test: {show(path)}" for path in kept)]
-        checks.record(ok, f"fuzz the scene loader for {seconds} s: {runs or 'no summary'}", details)
+        checks.record(ok, f"fuzz the scene loader and the live parser for {seconds} s in all: {runs or 'no summary'}",
+                      details)
     return finish
