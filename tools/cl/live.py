@@ -2,15 +2,26 @@
 labNN_solution, the reference) stepping its scene live beside a page in the
 browser (docs/DESIGN.md §3, "The live mode"). Builds the lab if needed, then
 becomes the program (`--live [PORT]`): it prints the page's URL and runs
-until Ctrl-C, SIGTERM or the page's stop."""
+until Ctrl-C, SIGTERM or the page's stop.
+
+`--bench` instead runs it in the background and measures, as a page would
+see it (a WebSocket client that acknowledges every frame): the latency from
+a drag message to the first frame that shows the particle held there (the
+median of 50 drags), and the frames per second at speed 16 (as fast as the
+steps go)."""
+import json
 import os
+import re
+import statistics
+import subprocess
 import sys
+import time
 
 from .base import CourseError
 from .build import BuildFailure, build_targets, configure
 from .labs import executable, resolve_lab
 
-USAGE = "usage: ./course live labNN [--port N] [lab flags]  (labNN_solution: the reference)"
+USAGE = "usage: ./course live labNN [--port N | --bench] [lab flags]  (labNN_solution: the reference)"
 
 
 def live_command(argv):
@@ -31,13 +42,66 @@ def live_command(argv):
     return name, [name, "--live", *port, *rest]
 
 
+def bench(program, args):
+    """Latency (s, median of 50 drags) and frames per second of `program --live ARGS`."""
+    import websocket  # Debian's python3-websocket
+    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, text=True)
+    try:
+        port, token = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=(\w+)", process.stdout.readline().strip()).groups()
+        client = websocket.create_connection(f"ws://127.0.0.1:{port}/ws?token={token}", timeout=10)
+        hello = json.loads(client.recv())
+        n = hello["particles"]
+
+        def next_status():
+            while True:
+                message = client.recv()
+                if isinstance(message, bytes):
+                    client.send('{"cmd": "ack"}')
+                elif json.loads(message)["type"] == "frame":
+                    return json.loads(message)
+
+        client.send('{"cmd": "speed", "value": 16}')
+        next_status()
+        first, start = next_status()["frame"], time.monotonic()
+        frames = 0
+        while time.monotonic() - start < 3:
+            last = next_status()
+            frames += 1
+        rate, steps = frames / (time.monotonic() - start), (last["frame"] - first) / (time.monotonic() - start)
+        client.send('{"cmd": "speed", "value": 1}')
+        particle, latencies = n - 1, []
+        for k in range(50):
+            target = [0.01 * (k % 5), -0.5 - 0.01 * k, 0.05]
+            sent = time.monotonic()
+            client.send(json.dumps({"cmd": "drag", "particle": particle, "x": target}))
+            while True:
+                held = next_status()["held"]
+                if held and max(abs(a - b) for a, b in zip(held[0]["x"], target)) < 1e-9:
+                    latencies.append(time.monotonic() - sent)
+                    break
+        client.send(json.dumps({"cmd": "release", "particle": particle}))
+        client.send('{"cmd": "stop"}')
+        process.wait(timeout=10)
+        return statistics.median(latencies), rate, steps, n
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
+
+
 def cmd_live(argv):
-    name, args = live_command(argv)
+    measuring = "--bench" in argv
+    name, args = live_command([a for a in argv if a != "--bench"])
     configure(log=sys.stderr)
     try:
         build_targets([name], log=sys.stderr)
     except BuildFailure as failure:
         raise CourseError(f"{name} does not build", details=failure.lines) from None
     program = executable(name)
+    if measuring:
+        latency, rate, steps, n = bench(program, args[1:])
+        print(f"{name} {' '.join(args[2:])}: {n} particles; drag to frame {1e3 * latency:.2f} ms (median of 50); "
+              f"{rate:.0f} frames/s received, {steps:.0f} steps/s at speed 16")
+        return 0
     sys.stdout.flush()
     os.execv(str(program), [str(program), *args[1:]])
