@@ -83,6 +83,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   free_inv_mass = free_count > 0 ? free_inv_mass / free_count : 1.0;
 
   Knobs knobs = run.knobs;
+  Knobs stepped_with = knobs;  // the values the last step was taken with
   const int dt_knob = knobs.find("dt");
   auto dt_now = [&] { return dt_knob >= 0 ? knobs[static_cast<std::size_t>(dt_knob)] : scene.dt; };
   auto energy_of = [&](const Particles& particles) {
@@ -107,7 +108,8 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   long version = 0;            // the state's, +1 at every change the page should see
   int frame = 0, steps_done = 0;
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
-  bool paused = false, stop = false, step_once = false, changed = false, refactored = false, rebase = true;
+  bool paused = false, stop = false, step_once = false, refactored = false, rebase = true;
+  bool changed = true;  // the first step builds what the lab keeps (run.changed)
   std::string problem;
   double energy_start = 0.0, energy_limit = 0.0, energy_now = energy_of(state);
   StrainStats strain = strain_stats(state.x, scene.springs);
@@ -223,10 +225,13 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   };
 
   auto step = [&] {
-    const Timer timer;
+    const Timer change_timer;
     if (changed && run.changed) run.changed(knobs), refactored = true;
     changed = false;
+    const double change_seconds = change_timer.seconds();  // a refactorization: the page says this step cost more
+    const Timer timer;
     const StepVerdict verdict = run.step(knobs);
+    stepped_with = knobs;
     for (auto& [p, hold] : holds) {  // a held particle is where the page holds it, whatever the step did
       state.x.col(p) = hold.target;
       state.v.col(p).setZero();
@@ -234,7 +239,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       if (hold.trail.size() > kTrail) hold.trail.erase(hold.trail.begin());
     }
     previous_step_seconds = last_step_seconds;
-    last_step_seconds = verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds();
+    last_step_seconds = (verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds()) + change_seconds;
     seconds += last_step_seconds;
     if (verdict.taken) ++frame, ++steps_done, time += dt_now();
     strain = strain_stats(state.x, scene.springs);
@@ -271,7 +276,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         }
         for (const Spring& spring : scene.springs) data.push_back(static_cast<float>(signed_strain(state.x, spring)));
         nlohmann::json values = nlohmann::json::object(), pinned = nlohmann::json::array(), held = nlohmann::json::array();
+        nlohmann::json used = nlohmann::json::object();
         for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
+        for (const Knob& knob : stepped_with.all()) used[knob.name] = knob.value;
         for (Eigen::Index p = 0; p < n; ++p) {
           if (state.inv_mass[p] <= 0.0 && !holds.count(static_cast<int>(p))) pinned.push_back(p);
         }
@@ -282,7 +289,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
                                 {"previous_step_seconds", previous_step_seconds}, {"refactored", refactored},
                                 {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
-                                {"paused", paused}, {"speed", speed}, {"knobs", values}, {"pinned", pinned},
+                                {"paused", paused}, {"speed", speed}, {"knobs", values}, {"step_knobs", used}, {"pinned", pinned},
                                 {"held", held}, {"problem", problem}, {"clients", server.clients()}}
                      .dump();
       }

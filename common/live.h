@@ -38,8 +38,9 @@ struct LiveRun {
   // One frame with the knobs' current values, on the scene's particles (their
   // inverse masses say what is pinned or held: read them every step).
   std::function<StepVerdict(const Knobs&)> step;
-  // Called before the step that follows a change of a knob, a pin or a held
-  // particle (lab 06 refactors there: that step's time includes it). Optional.
+  // Called before the first step and before the step that follows a change of
+  // a knob, a pin or a held particle (lab 06 refactors there: that step's time
+  // includes it, and its status says so). Optional.
   std::function<void(const Knobs&)> changed;
   // The energy the verdict watches, J; unset: kinetic + potential in the scene's gravity.
   std::function<double(const Particles&)> energy;

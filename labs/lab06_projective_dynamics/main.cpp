@@ -15,6 +15,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/live.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -26,6 +27,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab06::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 cl::lab06::Method method_of(const std::string& name) {
   return name == "newton" ? cl::lab06::Method::kNewton : cl::lab06::Method::kProjectiveDynamics;
@@ -50,6 +52,28 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.iterations = options.iterations;
   settings.tolerance = lab.tolerance;
 
+  if (live.on) {  // k, dt and a pin or a held particle change A: the solver is built again (refactored)
+    cl::refuse_run_flags(options, "not with --live (the page shows every step)", "");
+    const double k = scene.springs.empty() ? 1.0 : scene.springs.front().stiffness;
+    cl::LiveRun run{kLab, options.method, {{"K", "iterations", 1, 100, 1.0 * options.iterations, true},
+                                           {"dt", "s", 1e-4, 0.05, scene.dt}, {"k", "N/m", 1, 1e6, k}}};
+    std::vector<cl::Spring> springs = scene.springs;
+    std::optional<cl::lab06::Solver> live_solver;
+    run.changed = [&](const cl::Knobs& knobs) {
+      for (cl::Spring& spring : springs) spring.stiffness = knobs[2];
+      live_solver.emplace(cl::lab06::make_problem(scene.particles.inv_mass, springs, knobs[1]), method);
+    };
+    run.step = [&](const cl::Knobs& knobs) {
+      settings.iterations = knobs.integer(0);
+      const cl::lab06::StepReport report = live_solver->step(scene.particles, settings);
+      return cl::StepVerdict{report.problem, true, report.seconds};
+    };
+    run.energy = [&](const cl::Particles& state) {
+      return cl::kinetic_energy(state) + cl::potential_energy(state, scene.gravity) +
+             cl::lab06::spring_energy(state.x, springs);
+    };
+    return cl::run_live(scene, live, run, options.summary);
+  }
   cl::FrameOutput output =
       cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab06::step_columns(), options.method);
   cl::Particles& particles = scene.particles;
@@ -130,6 +154,7 @@ int main(int argc, char** argv) {
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--tolerance", lab.tolerance,
                  "stop a step's iterations once the objective's relative decrease falls below this (0: run all K)")
       .non_negative()

@@ -185,7 +185,7 @@ def drive(page, process, port, token):
     page.wait("the release", lambda: not page.status()["held"])
 
     page.js("var k = document.getElementById('knob-K'); k.value = 3; k.dispatchEvent(new Event('change'));")
-    page.wait("a frame stepped with K = 3", lambda: page.status()["knobs"]["K"] == 3)
+    page.wait("a frame stepped with K = 3", lambda: page.status()["step_knobs"]["K"] == 3)
     page.js("CLLive.send('{\"cmd\": \"pause\"')")
     error = page.wait("the error line", lambda: page.js("document.getElementById('error').textContent"))
     if "malformed JSON" not in error:
