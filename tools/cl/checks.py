@@ -309,9 +309,10 @@ def cmd_test(argv):
         for lab in without:
             checks.record(False, f"{lab}: no reference in solutions/{lab}/ (the honesty check needs one)")
         labs = [lab for lab in labs if lab not in without]
-        # The fuzzer runs alone: beside the honesty checks (a process per case)
-        # it managed 20 k inputs in its minute instead of about 300 k, and
-        # beside the sanitizer build, niced, 173 k (the two cores share caches).
+        # The fuzzers run alone, one per core: beside the honesty checks (a
+        # process per case) the scene loader's managed 20 k inputs in a minute
+        # instead of about 300 k, and beside the sanitizer build, niced, 173 k
+        # (the two cores share caches).
         fuzzing = check_fuzz(checks)
         if fuzzing:
             fuzzing()
