@@ -153,7 +153,7 @@ def drive(page, process, port, token):
     page.js("document.getElementById('pause').click()")
     page.wait("the run paused", lambda: (page.status() or {}).get("paused"))
     n = page.js("CLLive.mesh().particles")
-    x = [page.js(f"CLLive.position({p})") for p in range(n)]
+    x = page.js(f"Array.from({{length: {n}}}, function (_, p) {{ return CLLive.position(p); }})")
     particle = min(range(n), key=lambda p: x[p][0] + x[p][1])  # the bottom-left corner of a hanging curtain
     neighbour = min((p for p in range(n) if p != particle), key=lambda p: math.dist(x[p], x[particle]))
     rest = math.dist(x[neighbour], x[particle])
