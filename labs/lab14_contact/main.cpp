@@ -26,8 +26,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
   cl::lab14::ContactStepper stepper(scene, settings);
-  const cl::FrameOutput output =
+  cl::FrameOutput output =
       cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab14::step_columns(), options.method);
+  output.index_column = "step";
   cl::Particles& particles = scene.particles;
   const cl::lab14::RunResult result =
       cl::lab14::run_steps(particles, stepper, scene.springs, scene.colliders, scene.steps, nullptr, output);
