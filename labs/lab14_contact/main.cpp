@@ -86,8 +86,11 @@ int main(int argc, char** argv) {
   LabOptions lab;
   app.add_option("--friction", lab.friction, "Coulomb's mu for every collider (default: each collider's own)")
       .non_negative();
-  app.add_flag("--drape", lab.drape, "experiment 1: every method x --frictions on the scene -> drape.csv");
-  app.add_flag("--incline", lab.incline, "experiment 2: the stick/slip boundary against mu per method -> incline.csv");
+  const cl::Option method = app.get_option("--method");  // the experiments run every method
+  app.add_flag("--drape", lab.drape, "experiment 1: every method x --frictions on the scene -> drape.csv")
+      .excludes(method);
+  app.add_flag("--incline", lab.incline, "experiment 2: the stick/slip boundary against mu per method -> incline.csv")
+      .excludes(method);
   app.add_option("--frictions", lab.frictions, "--drape, --incline: the friction coefficients (default 0,0.3,1)")
       .delimiter(',');
   app.add_option("--angles", lab.angles, "--incline: the incline's angles, degrees in (0, 90) (default: 16 around "
