@@ -68,6 +68,7 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
       const cl::lab06::StepReport report = live_solver->step(scene.particles, settings);
       return cl::StepVerdict{report.problem, true, report.seconds};
     };
+    run.energy_name = "total energy";  // kinetic + potential + the springs' elastic
     run.energy = [&](const cl::Particles& state) {
       return cl::kinetic_energy(state) + cl::potential_energy(state, scene.gravity) +
              cl::lab06::spring_energy(state.x, springs);

@@ -3,6 +3,7 @@
 // multiplier. The experiment (experiments.cpp), one invocation per method:
 //   --sweep-iterations 1,2,...,1024   steady stretch against K -> stretch_vs_iterations_<method>.csv
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/live.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -22,6 +24,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab08::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 // The multipliers in newtons: λ / Δt² with Δt the substep (λ is force × Δt²).
 std::vector<double> multipliers_in_newtons(const Eigen::VectorXd& lambda, double substep) {
@@ -39,6 +42,31 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const cl::lab08::FrameSettings settings = cl::lab08::frame_settings(scene, options, lab, options.iterations);
   const std::optional<double> hanging = cl::lab08::hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
+  if (live.on) {  // k sets every spring's stiffness (XPBD's compliance 1/k; PBD's springs stay hard)
+    cl::refuse_run_flags(options, "not with --live (the page shows every frame)", "");
+    const bool finite = !scene.springs.empty() && std::isfinite(scene.springs[0].stiffness);
+    const double k0 = finite ? scene.springs[0].stiffness : 1e4;
+    cl::LiveRun run{kLab, options.method, {{"K", "sweeps", 0, 200, 1.0 * options.iterations, true},
+                                           {"dt", "s", 1e-4, 0.05, scene.dt}, {"k", "N/m", 1, 1e8, k0}}};
+    cl::lab04::ConstraintSet springs = constraints;
+    Eigen::VectorXd lambda;
+    run.changed = [&](const cl::Knobs& knobs) {
+      for (cl::Spring& spring : springs.springs) spring.stiffness = knobs[2] != k0 ? knobs[2] : spring.stiffness;
+    };
+    run.step = [&](const cl::Knobs& knobs) {
+      cl::lab08::FrameSettings frame = settings;
+      frame.iterations = knobs.integer(0);
+      frame.dt = knobs[1];
+      cl::lab08::advance_frame(scene.particles, springs, frame, lambda);
+      return cl::StepVerdict{};
+    };
+    run.energy_name = "total energy";  // kinetic + potential + the springs' elastic
+    run.energy = [&](const cl::Particles& state) {
+      return cl::kinetic_energy(state) + cl::potential_energy(state, scene.gravity) +
+             (settings.method == cl::lab08::Method::kXpbd ? cl::lab08::elastic_energy(state.x, springs.springs) : 0.0);
+    };
+    return cl::run_live(scene, live, run, options.summary);
+  }
   cl::lab08::RunPlan plan;
   plan.frames = scene.steps;
   plan.window_frames = cl::frames_in(lab.window_seconds, scene.dt);
@@ -132,6 +160,7 @@ int main(int argc, char** argv) {
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps |
                              cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--substeps", lab.substeps, "steps of dt/n per frame")
       .range(1, 1'000'000)
       .capture_default_str();
