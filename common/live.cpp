@@ -108,7 +108,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   long version = 0;            // the state's, +1 at every change the page should see
   int frame = 0, steps_done = 0;
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
-  bool paused = false, stop = false, step_once = false, refactored = false, rebase = true;
+  bool paused = false, stop = false, step_once = false, refactored = false, rebase = true, energy_noted = false;
   bool changed = true;  // the first step builds what the lab keeps (run.changed)
   std::string problem;
   double energy_start = 0.0, energy_limit = 0.0, energy_now = energy_of(state);
@@ -173,6 +173,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         state = start;
         holds.clear();
         problem.clear();
+        energy_noted = false;
         frame = 0, time = 0.0;
         changed = rebase = true;
         break;
@@ -251,7 +252,13 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       energy_limit = energy_scale(state, scene.gravity, dt_now());
       rebase = false;
     } else if (problem.empty() && holds.empty()) {
-      problem = energy_rise_problem(energy_now - energy_start, energy_limit, run.energy_name);
+      const std::string rose = energy_rise_problem(energy_now - energy_start, energy_limit, run.energy_name);
+      if (run.energy_stops) {
+        problem = rose;
+      } else if (!rose.empty() && !energy_noted) {
+        energy_noted = true;  // once per run (and again after a reset)
+        send_error(-1, "live: frame " + std::to_string(frame) + ": " + rose + " (reported; the run goes on)");
+      }
     }
     if (!problem.empty()) {
       paused = true;

@@ -45,6 +45,9 @@ struct LiveRun {
   // The energy the verdict watches, J; unset: kinetic + potential in the scene's gravity.
   std::function<double(const Particles&)> energy;
   std::string energy_name = "kinetic + potential energy";
+  // false: a rise above the scale is reported once (to the page and stderr)
+  // and the run goes on (lab 05's limited runs, as its frame loop does).
+  bool energy_stops = true;
 };
 
 // Serves the page on 127.0.0.1 (options.port, or a free one), prints its URL

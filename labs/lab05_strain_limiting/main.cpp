@@ -11,6 +11,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/live.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -21,6 +22,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab05::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 using cl::lab05::Limit;
 
 // ------------------------------------------------------------------ one run
@@ -32,6 +34,22 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab05::StepSettings settings = cl::lab05::step_settings(scene, options, lab, limit);
 
+  if (live.on) {  // the band's upper end; a rise of energy that the limiter contains is reported, not stopped at
+    cl::refuse_run_flags(options, "not with --live (the page shows every step)", "");
+    cl::LiveRun run{kLab, "limit " + lab.limit, {{"K", "sweeps", 0, 200, 1.0 * options.iterations, true},
+                                                 {"dt", "s", 1e-5, 0.05, scene.dt},
+                                                 {"sigma_max", "", 1, 2, lab.sigma_max}}};
+    run.step = [&](const cl::Knobs& knobs) {
+      cl::lab05::StepSettings step = settings;
+      step.iterations = knobs.integer(0);
+      step.dt = knobs[1];
+      step.sigma_max = knobs[2];
+      cl::lab05::limited_step(scene.particles, system, step);
+      return cl::StepVerdict{};
+    };
+    run.energy_stops = cl::lab05::checks_energy(limit);
+    return cl::run_live(scene, live, run, options.summary);
+  }
   cl::FrameOutput output =
       cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab05::step_columns(), "limit " + lab.limit);
   cl::Particles& particles = scene.particles;
@@ -125,6 +143,7 @@ int main(int argc, char** argv) {
                          cl::kFlagScene | cl::kFlagIterations | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--limit", lab.limit, "the limiter run after each step")
       .one_of({"none", "springs", "triangles-area", "triangles-stretch"})
       .capture_default_str();
