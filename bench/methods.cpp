@@ -18,6 +18,9 @@
 #include "labs/lab11_acceleration/accelerated.h"
 #include "labs/lab12_vertex_block_descent/descent.h"
 #include "labs/lab13_constrained_newton/iteration.h"
+#ifdef CL_BENCH_CONTACT
+#include "labs/lab14_contact/contact_step.h"
+#endif
 
 namespace cl::bench {
 
@@ -55,12 +58,31 @@ const std::vector<MethodInfo>& all_methods() {
   return methods;
 }
 
+const std::vector<MethodInfo>& contact_methods() {
+#ifdef CL_BENCH_CONTACT
+  static const std::vector<MethodInfo> methods{
+      {"contact-pbd", "lab14", Family::kHard, true, false},
+      {"contact-xpbd", "lab14", Family::kImplicitEuler, true, false},
+      {"contact-constrained", "lab14", Family::kLinearized, true, false},
+  };
+#else
+  static const std::vector<MethodInfo> methods;
+#endif
+  return methods;
+}
+
+bool models_colliders(const MethodInfo& method) { return method.lab == "lab14"; }
+
 const MethodInfo& method_info(const std::string& name) {
-  for (const MethodInfo& method : all_methods()) {
-    if (method.name == name) return method;
+  for (const auto* list : {&all_methods(), &contact_methods()}) {
+    for (const MethodInfo& method : *list) {
+      if (method.name == name) return method;
+    }
   }
   std::string known;
-  for (const MethodInfo& method : all_methods()) known += (known.empty() ? "" : ", ") + method.name;
+  for (const auto* list : {&all_methods(), &contact_methods()}) {
+    for (const MethodInfo& method : *list) known += (known.empty() ? "" : ", ") + method.name;
+  }
   throw std::invalid_argument("unknown method '" + name + "' (one of " + known + ")");
 }
 
@@ -340,6 +362,32 @@ class ConstrainedNewtonStepper : public Stepper {
   lab13::Settings settings_;
 };
 
+#ifdef CL_BENCH_CONTACT
+// Lab 14: its ContactStepper with the scene's colliders (each its own μ),
+// dt and gravity, K sweeps and contact passes (pbd, xpbd) or K block
+// Gauss-Seidel iterations (constrained).
+class ContactMethodStepper : public Stepper {
+ public:
+  ContactMethodStepper(const Scene& scene, int iterations, lab14::Method method)
+      : stepper_(scene, settings(scene, iterations, method)) {}
+  StepOutcome step(Particles& particles) override {
+    const lab14::StepReport report = stepper_.step(particles);
+    return {report.problem, stepper_.settings().iterations};
+  }
+
+ private:
+  static lab14::StepSettings settings(const Scene& scene, int iterations, lab14::Method method) {
+    lab14::StepSettings settings;
+    settings.method = method;
+    settings.dt = scene.dt;
+    settings.gravity = scene.gravity;
+    settings.iterations = iterations;
+    return settings;
+  }
+  lab14::ContactStepper stepper_;
+};
+#endif
+
 }  // namespace
 
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations) {
@@ -367,6 +415,13 @@ std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& sc
   if (name == "jacobi-chebyshev") {
     return std::make_unique<AcceleratedStepper>(scene, iterations, lab11::Method::kJacobiChebyshev);
   }
+#ifdef CL_BENCH_CONTACT
+  if (name == "contact-pbd") return std::make_unique<ContactMethodStepper>(scene, iterations, lab14::Method::kPbd);
+  if (name == "contact-xpbd") return std::make_unique<ContactMethodStepper>(scene, iterations, lab14::Method::kXpbd);
+  if (name == "contact-constrained") {
+    return std::make_unique<ContactMethodStepper>(scene, iterations, lab14::Method::kConstrained);
+  }
+#endif
   return std::make_unique<LimitedStepper>(scene, iterations, lab05::Limit::kTrianglesStretch);
 }
 

@@ -1,5 +1,5 @@
 #pragma once
-// The step of every solver of labs 04-13 behind one interface, for the two
+// The step of every solver of labs 04-14 behind one interface, for the two
 // cross-lab programs (trade.cpp: the speed/accuracy trade; extremes.cpp: the
 // stability matrix). Each wraps a lab's REFERENCE code and keeps what that
 // lab's own loop keeps between steps (XPBD's multipliers, lab 09's previous
@@ -41,7 +41,15 @@ struct MethodInfo {
 // constrained-newton, constrained-newton-drop (lab 13: compressed springs
 // kept in K_g, the lab's default, or dropped).
 const std::vector<MethodInfo>& all_methods();
-// Throws std::invalid_argument for an unknown name (the message lists them).
+// Lab 14's three steps with contact against the scene's colliders:
+// contact-pbd (lab 04's step, then the contact projection with friction),
+// contact-xpbd (lab 08's), contact-constrained (lab 07's Schur step with the
+// contact rows by projected Gauss-Seidel). Not in all_methods(): they are the
+// extremes' contact cells. Empty in a build without lab 14's reference.
+const std::vector<MethodInfo>& contact_methods();
+// Whether the method steps against the scene's colliders (one of contact_methods()).
+bool models_colliders(const MethodInfo& method);
+// Either list's method; throws std::invalid_argument for an unknown name (the message lists them).
 const MethodInfo& method_info(const std::string& name);
 
 struct StepOutcome {
@@ -64,7 +72,9 @@ class Stepper {
 // dt; the current positions of scene.particles are the rest shape where the
 // method needs one (lab 10's hierarchy, lab 05's triangles). `iterations` is
 // K (sweeps per level for hpbd; the most iterations for newton and
-// constrained-newton).
+// constrained-newton; the PBD sweeps and contact passes, or the block
+// Gauss-Seidel iterations, of the contact methods; those also take the
+// scene's colliders and their friction).
 // Throws std::invalid_argument or cl::InputError, with the lab's message,
 // when the method does not take the scene (e.g. PD and a hard spring).
 std::unique_ptr<Stepper> make_stepper(const std::string& method, const Scene& scene, int iterations);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "common/health.h"
@@ -116,6 +117,40 @@ void check_settings(const StepSettings& settings) {
   }
 }
 
+// The last resort of every step (README.md, "Detection"): a movable particle
+// that started the step outside every collider but ends it inside one (the
+// passes or the contact sweeps moved it into a collider its contacts did not
+// list, or two overlapping colliders' contacts undid each other) goes back
+// along its move to the first point where it touches a collider, and its
+// velocity becomes that move over Δt. Bisection on t ∈ [0, 1] keeps the
+// outside end (s ≥ 0 for every collider: s is convex along the move and >= 0
+// at its start, so it stays >= 0 up to its first root). Returns how many
+// particles it moved.
+int move_back_inside(Particles& particles, const Eigen::Matrix3Xd& start, const std::vector<Collider>& colliders,
+                     double dt) {
+  if (colliders.empty()) return 0;
+  auto least = [&](const Eigen::Vector3d& y) {
+    double s = std::numeric_limits<double>::infinity();
+    for (const Collider& collider : colliders) s = std::min(s, surface_distance(collider, y).distance);
+    return s;
+  };
+  int moved = 0;
+  for (Eigen::Index i = 0; i < particles.x.cols(); ++i) {
+    if (!(particles.inv_mass[i] > 0.0)) continue;
+    const Eigen::Vector3d from = start.col(i), to = particles.x.col(i);
+    if (least(to) >= -kOnSurface || least(from) < -kOnSurface) continue;
+    double outside = 0.0, inside = 1.0;
+    for (int k = 0; k < 200 && inside - outside > 1e-16; ++k) {
+      const double middle = 0.5 * (outside + inside);
+      if (least(from + middle * (to - from)) >= 0.0) outside = middle; else inside = middle;
+    }
+    particles.x.col(i) = from + outside * (to - from);
+    particles.v.col(i) = (particles.x.col(i) - from) / dt;
+    ++moved;
+  }
+  return moved;
+}
+
 void tally(StepReport& report) {
   for (std::size_t c = 0; c < report.contacts.size(); ++c) {
     const Contact& contact = report.contacts[c];
@@ -216,6 +251,7 @@ StepReport ContactStepper::position_step(Particles& particles) {
   for (const Contact& contact : report.contacts) {
     particles.v.col(contact.particle) = (particles.x.col(contact.particle) - start.col(contact.particle)) / settings_.dt;
   }
+  report.moved_back = move_back_inside(particles, start, colliders_, settings_.dt);
   for (std::size_t c = 0; c < report.contacts.size(); ++c) {
     if (report.contacts[c].swept) ++report.swept;
     const ContactMultipliers& lambda = report.multipliers[c];
@@ -288,7 +324,9 @@ StepReport ContactStepper::constrained_step(Particles& particles) {
                                  (report.multipliers[c].tangent - before.tangent);
     }
   }
+  const Eigen::Matrix3Xd start = particles.x;
   lab07::update_positions(particles, map_, velocity, dt);
+  report.moved_back = move_back_inside(particles, start, colliders_, dt);
   tally(report);
   return report;
 }

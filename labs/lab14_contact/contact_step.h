@@ -69,6 +69,12 @@ struct StepReport {
   double max_normal_force = 0.0;  // max λ_n, N
   double normal_force = 0.0;      // Σ λ_n, N
   Eigen::Vector3d contact_force = Eigen::Vector3d::Zero();  // Σ (λ_n n + λ_t), N
+  // Particles that started the step outside every collider, ended it inside
+  // one (deeper than 1e-12 m) and were moved back along their step to where
+  // they first touched a collider (README.md, "Detection": overlapping
+  // colliders, or a collider the step's contacts did not list). 0 in a
+  // scene whose colliders the contacts handle alone.
+  int moved_back = 0;
   std::string problem;            // constrained: the springs' matrix could not be factored (the step was not taken)
 };
 
@@ -89,6 +95,9 @@ class ContactStepper {
   // contact forces f_c, the contacts detected on x → x + Δt u of the first
   // solve (margin: the largest Δt‖u_i‖), then contact_pgs_update on each;
   // then lab 07's update_positions.
+  // Both: a particle that started outside every collider and ends more than
+  // 1e-12 m inside one goes back along its move to where it first touches a
+  // collider (StepReport::moved_back; README.md, "The last resort").
   StepReport step(Particles& particles);
   const StepSettings& settings() const { return settings_; }
 
