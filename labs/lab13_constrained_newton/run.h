@@ -1,0 +1,22 @@
+#pragma once
+// Lab 13 — given code: one run of a scene, the driver's default mode
+// (main.cpp keeps the flags and the dispatch): constrained Newton's steps
+// (per_step.csv, iterations.csv, the run summary), lab 06's Newton or PD on
+// the same scene for comparison, or with --live either method stepping beside
+// a page in the browser (common/live.h; docs/DESIGN.md §3, "The live mode").
+#include <string>
+
+#include "common/cli.h"
+#include "common/live.h"
+#include "experiments.h"
+
+namespace cl::lab13 {
+
+// Runs --scene (with --stiffness; lab 06's methods refuse hard springs) by
+// --method for its steps, or with live.on until the page or a signal stops it:
+// knobs K (iterations), dt and k (every spring's stiffness, N/m; none when
+// the springs are hard), each change of which builds the solver again.
+int run_scene(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, LabOptions lab,
+              const LiveOptions& live);
+
+}  // namespace cl::lab13
