@@ -139,7 +139,8 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     server.send_text(client, nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
                                             {"method", run.method}, {"particles", n}, {"springs", springs},
                                             {"triangles", triangles}, {"rest_lengths", rest}, {"knobs", nlohmann::json::parse(knobs.json())},
-                                            {"energy_name", run.energy_name}, {"command", command_line()}}
+                                            {"energy_name", run.energy_name}, {"command", command_line()},
+                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}
                                  .dump());
   };
 

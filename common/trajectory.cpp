@@ -82,6 +82,29 @@ double signed_strain(const Eigen::Matrix3Xd& x, const Spring& spring) {
   return spring.rest_length > 0.0 ? (length - spring.rest_length) / spring.rest_length : length;
 }
 
+std::string colliders_json(const std::vector<Collider>& colliders) {
+  using Json = nlohmann::ordered_json;
+  auto point = [](const Eigen::Vector3d& p) { return Json::array({p.x(), p.y(), p.z()}); };
+  Json list = Json::array();
+  for (const Collider& c : colliders) {
+    Json item{{"type", shape_name(c.shape)}};
+    if (c.shape == ColliderShape::kPlane) {
+      item["point"] = point(c.a);
+      item["normal"] = point(c.normal);
+    } else if (c.shape == ColliderShape::kSphere) {
+      item["centre"] = point(c.a);
+      item["radius"] = c.radius;
+    } else {
+      item["a"] = point(c.a);
+      item["b"] = point(c.b);
+      item["radius"] = c.radius;
+    }
+    item["friction"] = c.friction;
+    list.push_back(item);
+  }
+  return list.dump();
+}
+
 TrajectoryWriter::TrajectoryWriter(const std::string& dir, int every, const Scene& scene, TrajectoryIdentity identity)
     : dir_(dir), every_(every), scene_(scene), identity_(std::move(identity)) {
   if (every < 1) {
@@ -195,6 +218,7 @@ std::string TrajectoryWriter::header_text() const {
               {"max_position_error", max_error},
               {"frame_count", records_.size()},
               {"frames", frames}};
+  if (!scene.colliders.empty()) header["colliders"] = Json::parse(colliders_json(scene.colliders));
   if (stopped_frame_ >= 0) header["stopped"] = Json{{"frame", stopped_frame_}, {"status", stopped_status_}};
   return header.dump() + "\n";
 }

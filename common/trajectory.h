@@ -43,6 +43,12 @@ const std::string& command_line();
 // (> 0 stretched), and for L = 0 the length ‖x_i − x_j‖ (m).
 double signed_strain(const Eigen::Matrix3Xd& x, const Spring& spring);
 
+// The scene's colliders as the trajectory's header (key "colliders", only when
+// there are any) and the live page's hello carry them, for drawing: a JSON
+// array, each {"type", "friction"} and plane: "point", "normal"; sphere:
+// "centre", "radius"; capsule: "a", "b", "radius" (the scene file's names, m).
+std::string colliders_json(const std::vector<Collider>& colliders);
+
 struct TrajectoryIdentity {
   std::string lab;
   std::string method;

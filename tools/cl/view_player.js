@@ -77,7 +77,48 @@
     }
   }
 
-  window.CLPlayer = { strainColour: strainColour, makeRunScene: makeRunScene, setRunFrame: setRunFrame };
+  // A scene's colliders (lab 14; the header's or the live hello's "colliders")
+  // into a three.js scene: spheres and capsules shaded, drawn 1 % thinner so
+  // that cloth lying on them (its springs are chords, just under the surface)
+  // stays in sight; a plane as a square of half-side `extent` (m) around the
+  // point of it nearest `centre` (the cloth's box centre). Returns how many.
+  function addColliders(scene, colliders, centre, extent) {
+    if (!colliders || !colliders.length) return 0;
+    var solid = new THREE.MeshLambertMaterial({ color: 0xc8b89a, transparent: true, opacity: 0.8 });
+    var flat = new THREE.MeshLambertMaterial({ color: 0xa8a8a0, side: THREE.DoubleSide, transparent: true, opacity: 0.45 });
+    function v(p) { return new THREE.Vector3(p[0], p[1], p[2]); }
+    function ball(at, r) {
+      var mesh = new THREE.Mesh(new THREE.SphereGeometry(0.99 * r, 32, 16), solid);
+      mesh.position.copy(at);
+      scene.add(mesh);
+    }
+    colliders.forEach(function (c) {
+      if (c.type === 'sphere') ball(v(c.centre), c.radius);
+      if (c.type === 'capsule') {
+        var a = v(c.a), b = v(c.b), axis = b.clone().sub(a), length = axis.length();
+        ball(a, c.radius);
+        ball(b, c.radius);
+        if (length > 0) {
+          var tube = new THREE.Mesh(new THREE.CylinderGeometry(0.99 * c.radius, 0.99 * c.radius, length, 32, 1, true), solid);
+          tube.position.copy(a.clone().add(b).multiplyScalar(0.5));
+          tube.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), axis.normalize());
+          scene.add(tube);
+        }
+      }
+      if (c.type === 'plane') {
+        var n = v(c.normal).normalize(), o = v(centre);
+        var foot = o.sub(n.clone().multiplyScalar(o.clone().sub(v(c.point)).dot(n)));
+        var square = new THREE.Mesh(new THREE.PlaneGeometry(2 * extent, 2 * extent), flat);
+        square.position.copy(foot);
+        square.quaternion.setFromUnitVectors(new THREE.Vector3(0, 0, 1), n);
+        scene.add(square);
+      }
+    });
+    return colliders.length;
+  }
+
+  window.CLPlayer = { strainColour: strainColour, makeRunScene: makeRunScene, setRunFrame: setRunFrame,
+                      addColliders: addColliders };
   if (!document.getElementById('run0')) return;  // the live page: no replay
 
   var body = document.body;
@@ -124,6 +165,9 @@
     });
     h.frames.forEach(function (f) { runScale = Math.max(runScale, f.strain_scale); });
     var parts = makeRunScene(h, h.pinned.length);
+    var first = h.frames[0], box = [0, 1, 2].map(function (a) { return 65535 * first.step[a]; });
+    run.colliders = addColliders(parts.scene, h.colliders, [0, 1, 2].map(function (a) { return first.box_min[a] + box[a] / 2; }),
+                                 Math.max(box[0], box[1], box[2], 1e-3));
     run.scene = parts.scene;
     run.lines = parts.lines;
     run.points = parts.points;
@@ -294,6 +338,7 @@
   body.setAttribute('data-frames', list(function (run) { return run.header.frames.length; }));
   body.setAttribute('data-particles', list(function (run) { return run.header.particles; }));
   body.setAttribute('data-springs', list(function (run) { return run.header.springs.length / 2; }));
+  body.setAttribute('data-colliders', list(function (run) { return run.colliders; }));
   show(shown);
   markOutside();
   // ms from the start of the page's navigation to its first frame drawn (the load-time benchmark).
