@@ -4,12 +4,14 @@
 // slide, energy) and the run summary. The experiments (experiments.cpp):
 //   --drape     every method × --frictions on the scene: drape.csv
 //   --incline   the stick/slip boundary against μ per method: incline.csv
+//   --live      the scene steps beside a page in the browser (./course live)
 #include <cstdio>
 #include <optional>
 #include <string>
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/live.h"
 #include "common/output.h"
 #include "common/sparse.h"
 #include "common/summary.h"
@@ -20,9 +22,33 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab14::LabOptions;
+cl::LiveOptions live;  // --live [PORT]
+
+// --live: K, dt and mu (every collider's, as --friction sets it); a change of
+// one, a pin or a held particle builds the stepper again.
+int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene& scene) {
+  cl::refuse_run_flags(options, "not with --live (the page shows every step)", "");
+  const double mu = lab.friction ? *lab.friction : (scene.colliders.empty() ? 0.0 : scene.colliders[0].friction);
+  cl::LiveRun run{kLab, options.method, {{"K", "iterations", 1, 200, 1.0 * options.iterations, true},
+                                         {"dt", "s", 1e-4, 0.05, scene.dt}, {"mu", "", 0, 2, mu}}};
+  cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
+  std::optional<cl::lab14::ContactStepper> stepper;
+  run.changed = [&](const cl::Knobs& knobs) {
+    settings.iterations = knobs.integer(0);
+    settings.dt = knobs[1];
+    settings.friction = knobs[2];
+    stepper.emplace(scene, settings);
+  };
+  run.step = [&](const cl::Knobs&) {
+    const cl::lab14::StepReport report = stepper->step(scene.particles);
+    return cl::StepVerdict{report.problem, report.problem.empty()};
+  };
+  return cl::run_live(scene, live, run, options.summary);
+}
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  if (live.on) return run_live(options, lab, scene);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
   cl::lab14::ContactStepper stepper(scene, settings);
@@ -84,6 +110,7 @@ int main(int argc, char** argv) {
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   app.get_option("--iterations").range(1, 100000);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--friction", lab.friction, "Coulomb's mu for every collider (default: each collider's own)")
       .non_negative();
   const cl::Option method = app.get_option("--method");  // the experiments run every method
@@ -98,6 +125,7 @@ int main(int argc, char** argv) {
   return cl::run_main(app, argc, argv, [&] {
     cl::set_blas_threads(1);  // CHOLMOD's BLAS: small solves, and idle OpenBLAS threads spin (lab 13)
     cl::lab14::check_lab_options(lab);
+    if (live.on && (lab.drape || lab.incline)) throw cl::InputError("--live: not with --drape or --incline");
     if (lab.drape && lab.incline) throw cl::InputError("--incline: not together with --drape");
     if (lab.drape) return cl::lab14::run_drape(kLab, CL_LAB_SCENE_DIR, options, lab);
     if (lab.incline) return cl::lab14::run_incline(kLab, options, lab);
