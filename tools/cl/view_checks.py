@@ -158,13 +158,14 @@ def check_browser(checks):
     scratch.mkdir(parents=True)
     runs = {"a": ["--scene", "curtain-8", "--iterations", "1", "--steps", "60", "--frames", "4"],
             "b": ["--scene", "curtain-8", "--iterations", "16", "--steps", "60", "--frames", "4"],
-            "rope": ["--scene", "rope-50", "--steps", "40", "--frames", "5"]}
+            "drape": ["--scene", "drape-sphere", "--steps", "2", "--frames", "1"]}  # lab 14's: colliders
     for name, args in runs.items():
-        done = subprocess.run([str(program), *args, "--out", str(scratch / name),
+        runner = BIN / "lab14_contact_solution" if name == "drape" else program
+        done = subprocess.run([str(runner), *args, "--out", str(scratch / name),
                                "--summary", str(scratch / f"{name}.json")],
                               capture_output=True, text=True, check=False)
         if done.returncode != 0:
-            checks.record(False, f"the view's runs: {program.name} {shlex.join(args)} exited {done.returncode}",
+            checks.record(False, f"the view's runs: {runner.name} {shlex.join(args)} exited {done.returncode}",
                           done.stderr.splitlines()[-3:])
             return
     problems = view_refusal_problems(scratch)
@@ -210,14 +211,19 @@ def check_browser(checks):
 
     problems = []
     run_b = load_run(scratch / "b")
-    for names, runs_shown in ((["a", "b"], [run_a, run_b]), (["a", "rope"], [run_a, load_run(scratch / "rope")])):
+    run_drape = load_run(scratch / "drape")
+    if "colliders" in run_a[0] or len(run_drape[0].get("colliders", [])) != 2:
+        problems.append(f"colliders in trajectory.json: lab 04's {run_a[0].get('colliders')} (none expected), "
+                        f"drape-sphere's {run_drape[0].get('colliders')} (its scene has 2)")
+    for names, runs_shown in ((["a", "b"], [run_a, run_b]), (["a", "drape"], [run_a, run_drape])):
         page = write_view([scratch / n for n in names], scratch / f"view-{'-'.join(names)}.html")
         shot = scratch / f"{'-'.join(names)}.png"
         attrs, found = open_in_chromium(chromium, page, last, shot)
         problems += found
         expected = {"data-runs": "2",
                     "data-particles": ",".join(str(r[0]["particles"]) for r in runs_shown),
-                    "data-frames": ",".join(str(r[0]["frame_count"]) for r in runs_shown)}
+                    "data-frames": ",".join(str(r[0]["frame_count"]) for r in runs_shown),
+                    "data-colliders": ",".join(str(len(r[0].get("colliders", []))) for r in runs_shown)}
         problems += [f"{'+'.join(names)}: {k} = {attrs.get(k)!r}, the files say {v}" for k, v in expected.items()
                      if attrs.get(k) != v]
         if attrs and names[1] == "b":
@@ -228,5 +234,5 @@ def check_browser(checks):
             if not drawn(share):
                 problems.append(f"{'+'.join(names)}: the screenshot is blank ({100 * share:.2f} %)")
     checks.record(not problems, "side-by-side views in headless Chromium: K = 1 against K = 16 (one clock, and "
-                  "every control inside the window at 800 and 1200 px), and a curtain beside a rope (different "
-                  "particle counts)", problems)
+                  "every control inside the window at 800 and 1200 px), a curtain beside lab 14's drape "
+                  "(different particle counts; the drape's sphere and floor drawn, no collider in lab 04's)", problems)
