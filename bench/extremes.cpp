@@ -399,10 +399,13 @@ int run(const Options& options) {
     ++(contact ? contact_methods : spring_methods);
     (contact ? contact_cells : spring_cells) += plan.back().size();
   }
-  std::printf("extremes: %zu methods x %zu cells on a %dx%d curtain", spring_methods,
-              spring_methods > 0 ? spring_cells / spring_methods : 0, kN, kN);
+  std::printf("extremes:");
+  if (spring_methods > 0) {
+    std::printf(" %zu methods x %zu cells on a %dx%d curtain", spring_methods, spring_cells / spring_methods, kN, kN);
+  }
   if (contact_methods > 0) {
-    std::printf(", %zu contact methods x %zu cells with colliders", contact_methods, contact_cells / contact_methods);
+    std::printf("%s %zu contact methods x %zu cells with colliders", spring_methods > 0 ? "," : "",
+                contact_methods, contact_cells / contact_methods);
   }
   std::printf("; %d steps (%d with 10,000 iterations)\n", steps, long_steps);
   std::fflush(stdout);
