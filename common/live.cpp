@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <set>
 #include <sstream>
 #include <vector>
 
@@ -105,6 +106,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
 
   std::map<int, Hold> holds;   // by particle
   std::map<int, long> sent;    // per client: the version of the state it was last sent
+  std::set<int> greeted;       // clients sent the hello: only they get frames (a frame before it has no mesh)
   long version = 0;            // the state's, +1 at every change the page should see
   int frame = 0, steps_done = 0;
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
@@ -130,6 +132,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     ++version;
   };
   auto hello = [&](int client) {
+    greeted.insert(client);
     nlohmann::json springs = nlohmann::json::array(), rest = nlohmann::json::array();
     for (const Spring& spring : scene.springs) springs.push_back(spring.i), springs.push_back(spring.j), rest.push_back(spring.rest_length);
     nlohmann::json triangles = nlohmann::json::array();
@@ -151,6 +154,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     }
     if (inbound.closed) {
       sent.erase(inbound.client);
+      greeted.erase(inbound.client);
       for (auto hold = holds.begin(); hold != holds.end();) {
         auto next = std::next(hold);
         if (hold->second.client == inbound.client) release(hold);
@@ -275,7 +279,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     std::vector<float> data;
     std::string status;
     for (const int client : server.ready_clients()) {
-      if (sent.count(client) && sent[client] == version) continue;
+      if (!greeted.count(client) || (sent.count(client) && sent[client] == version)) continue;
       if (data.empty()) {
         const std::size_t m = scene.springs.size();
         data.reserve(3 * static_cast<std::size_t>(n) + m);
