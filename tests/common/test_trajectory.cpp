@@ -123,6 +123,37 @@ TEST_CASE("a trajectory reads back to the stated quantisation, with its topology
   }
 }
 
+TEST_CASE("a scene's colliders travel in the header, and a scene without writes no colliders key",
+          "[common][trajectory]") {
+  cl::Scene scene = small_scene();
+  const auto header_of = [&] {
+    cl::TrajectoryWriter writer("trajectory_test_out/colliders", 1, scene, {"lab99_test", "m", "total energy", "s"});
+    writer.add(0, 0.0, scene.particles.x, 0.0, "ok");
+    return nlohmann::json::parse(writer.header_text());
+  };
+  CHECK_FALSE(header_of().contains("colliders"));
+  cl::Collider plane, sphere, capsule;
+  plane.a = {0.0, -1.0, 0.0};
+  plane.normal = {0.0, 1.0, 0.0};
+  plane.friction = 0.5;
+  sphere.shape = cl::ColliderShape::kSphere;
+  sphere.a = {1.0, 2.0, 3.0};
+  sphere.radius = 0.25;
+  capsule.shape = cl::ColliderShape::kCapsule;
+  capsule.a = {0.0, 0.0, 0.0};
+  capsule.b = {1.0, 0.0, 0.0};
+  capsule.radius = 0.1;
+  scene.colliders = {plane, sphere, capsule};
+  const nlohmann::json colliders = header_of()["colliders"];
+  REQUIRE(colliders.size() == 3);
+  CHECK(colliders[0] == nlohmann::json{{"type", "plane"}, {"point", {0.0, -1.0, 0.0}}, {"normal", {0.0, 1.0, 0.0}},
+                                       {"friction", 0.5}});
+  CHECK(colliders[1] == nlohmann::json{{"type", "sphere"}, {"centre", {1.0, 2.0, 3.0}}, {"radius", 0.25},
+                                       {"friction", 0.0}});
+  CHECK(colliders[2] == nlohmann::json{{"type", "capsule"}, {"a", {0.0, 0.0, 0.0}}, {"b", {1.0, 0.0, 0.0}},
+                                       {"radius", 0.1}, {"friction", 0.0}});
+}
+
 TEST_CASE("the frame loop keeps every N-th frame, the last planned one and the frame that stopped",
           "[common][trajectory]") {
   cl::Scene scene = small_scene();
