@@ -5,6 +5,7 @@
 // (experiments.cpp):
 //   --compare-pbd 1,4,16 --compare-substeps 1,2,4   PBD (lab 04) against this
 //                                                   lab's two solves -> compare.csv
+//   --live [PORT]   the scene's steps beside a page in the browser (run.cpp)
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -21,12 +22,14 @@
 #include "constrained.h"
 #include "experiments.h"
 #include "pbd.h"
+#include "run.h"
 #include "step.h"
 
 namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab07::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 // ------------------------------------------------------------------ one run
 
@@ -154,7 +157,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
-  if (lab.compare_pbd.empty() && lab.compare_substeps.empty()) return run_one(options, lab);
+  const bool compare = !lab.compare_pbd.empty() || !lab.compare_substeps.empty();
+  if (live.on && compare) throw cl::InputError("--live: not with --compare-pbd or --compare-substeps");
+  if (live.on) return cl::lab07::run_live_scene(kLab, CL_LAB_SCENE_DIR, options, lab, live);
+  if (!compare) return run_one(options, lab);
   cl::refuse_run_flags(options, "only for one run (not with --compare-pbd or --compare-substeps)",
                        "a comparison writes compare.csv, not a run summary");
   return cl::lab07::run_compare(kLab, CL_LAB_SCENE_DIR, options, lab);
@@ -173,6 +179,7 @@ int main(int argc, char** argv) {
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_flag("--stabilize", lab.stabilize,
                "after every step, project the positions once onto the hard constraints (velocities unchanged)");
   app.add_option("--regularize", lab.regularize,

@@ -1,0 +1,54 @@
+#include "run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/driver.h"
+#include "common/metrics.h"
+#include "step.h"
+
+namespace cl::lab07 {
+
+int run_live_scene(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
+                   const LabOptions& lab, const LiveOptions& live) {
+  refuse_run_flags(options, "not with --live (the page shows every step)", "");
+  Scene scene = load_scene_for(options, scene_dir);
+  apply_stiffness(scene, lab.stiffness);
+  const bool finite = !scene.springs.empty() && std::all_of(scene.springs.begin(), scene.springs.end(),
+                                                             [](const Spring& s) { return std::isfinite(s.stiffness); });
+  std::vector<Knob> declared{{"dt", "s", 1e-4, 0.05, scene.dt},
+                             {"stabilize", "off/on", 0, 1, lab.stabilize ? 1.0 : 0.0, true}};
+  if (finite) declared.push_back({"k", "N/m", 1, 1e10, scene.springs.front().stiffness});
+  LiveRun run{lab_name, options.method, Knobs(declared)};
+
+  StepSettings settings;
+  settings.gravity = scene.gravity;
+  settings.method = options.method == "kkt" ? Method::kKkt : Method::kSchur;
+  settings.regularization = lab.regularize;
+  MovableMap map;
+  Eigen::VectorXd lambda;  // the last step's multipliers (the springs' elastic energy)
+  run.changed = [&](const Knobs& knobs) {
+    map = make_movable_map(scene.particles.inv_mass);  // a pin or a held particle is no longer an unknown
+    if (finite) {
+      for (Spring& spring : scene.springs) spring.stiffness = knobs[2];
+    }
+    lambda.resize(0);
+  };
+  run.step = [&](const Knobs& knobs) -> StepVerdict {
+    settings.dt = knobs[0];
+    const StepResult result = constrained_step(scene.particles, scene.springs, map, settings);
+    if (!result.ok) return {"singular: " + result.problem, false};
+    lambda = result.lambda;
+    if (knobs.integer(1) == 1) {
+      const ProjectionResult projection = stabilize_positions(scene.particles, scene.springs, map);
+      if (!projection.ok) return {"singular: " + projection.problem, false};
+    }
+    return {};
+  };
+  run.energy_name = "total energy";  // kinetic + potential + the finite springs' elastic, from λ
+  run.energy = [&](const Particles& state) { return total_energy(state, scene, lambda); };
+  return run_live(scene, live, run, options.summary);
+}
+
+}  // namespace cl::lab07
