@@ -8,7 +8,7 @@ experiment 1) and writes beside it:
                       energy
 and every OUTDIR/lab14_contact/drape-*/per_step.csv (the demo's drape runs),
 writing beside each:
-  drape_history.png   contacts (sticking, sliding) and the kinetic energy per step
+  drape_history.png   contacts found and active (sticking, sliding) and the kinetic energy per step
 Exit 4 when neither is there.
 """
 import _figures as figures
@@ -48,10 +48,12 @@ def draw_table(table, target):
 
 def draw_history(per_step, target):
     found = figures.rows(per_step, ok_only=True)
-    data = {key: figures.column(found, key) for key in ("time", "contacts", "sticking", "sliding", "kinetic")}
+    # A per_step.csv of an earlier release has one "contacts" column (the ones found).
+    counts = ("contacts_found", "contacts_active") if found and "contacts_found" in found[0] else ("contacts",)
+    data = {key: figures.column(found, key) for key in ("time", *counts, "sticking", "sliding", "kinetic")}
     figure, (left, right) = plt.subplots(1, 2, figsize=(9, 3.6))
-    for key in ("contacts", "sticking", "sliding"):
-        left.plot(data["time"], data[key], label=key)
+    for key in (*counts, "sticking", "sliding"):
+        left.plot(data["time"], data[key], label=key.replace("contacts_", ""))
     figures.finish(left, "time (s)", "contacts per step (1)")
     right.semilogy(data["time"], [max(k, 1e-12) for k in data["kinetic"]])
     figures.finish(right, "time (s)", "kinetic energy (J)", legend=None)

@@ -151,11 +151,17 @@ int move_back_inside(Particles& particles, const Eigen::Matrix3Xd& start, const 
   return moved;
 }
 
+// A contact acted when it pushed (λ_n > 0) or its friction moved the
+// particle; the second needs the first (the cone is μ λ_n wide, and the
+// position-based friction is limited by μ times the normal correction).
+bool acted(const ContactMultipliers& lambda) { return lambda.normal > 0.0 || lambda.tangent.squaredNorm() > 0.0; }
+
 void tally(StepReport& report) {
   for (std::size_t c = 0; c < report.contacts.size(); ++c) {
     const Contact& contact = report.contacts[c];
     const ContactMultipliers& lambda = report.multipliers[c];
     if (contact.swept) ++report.swept;
+    if (acted(lambda)) ++report.active;
     report.max_normal_force = std::max(report.max_normal_force, lambda.normal);
     report.normal_force += lambda.normal;
     report.contact_force += lambda.normal * contact.normal + lambda.tangent;
@@ -255,6 +261,7 @@ StepReport ContactStepper::position_step(Particles& particles) {
   for (std::size_t c = 0; c < report.contacts.size(); ++c) {
     if (report.contacts[c].swept) ++report.swept;
     const ContactMultipliers& lambda = report.multipliers[c];
+    if (acted(lambda)) ++report.active;
     report.max_normal_force = std::max(report.max_normal_force, lambda.normal);
     report.normal_force += lambda.normal;
     report.contact_force += lambda.normal * report.contacts[c].normal + lambda.tangent;
@@ -366,14 +373,17 @@ RunResult run_steps(Particles& particles, ContactStepper& stepper, const std::ve
     if (frame > 0) result.max_penetration = std::max(result.max_penetration, record.penetration);
     result.max_normal_force = std::max(result.max_normal_force, r.max_normal_force);
     result.contacts += static_cast<long long>(r.contacts.size());
+    result.active += r.active;
+    result.moved_back += r.moved_back;
     result.swept += r.swept;
     result.sticking += r.sticking;
     result.sliding += r.sliding;
     FrameMeasure measured;
     measured.strain = record.strain;
     measured.energy = total;
-    measured.row = {static_cast<long long>(r.contacts.size()), static_cast<long long>(r.swept),
-                    static_cast<long long>(r.sticking), static_cast<long long>(r.sliding), record.penetration,
+    measured.row = {static_cast<long long>(r.contacts.size()), static_cast<long long>(r.active),
+                    static_cast<long long>(r.swept), static_cast<long long>(r.sticking),
+                    static_cast<long long>(r.sliding), static_cast<long long>(r.moved_back), record.penetration,
                     r.max_normal_force, r.normal_force, record.kinetic, record.potential, total, record.strain.max,
                     seconds};
     return measured;
@@ -385,8 +395,8 @@ RunResult run_steps(Particles& particles, ContactStepper& stepper, const std::ve
 }
 
 std::vector<std::string> step_columns() {
-  return {"contacts", "swept", "sticking", "sliding", "max_penetration", "max_normal_force", "normal_force",
-          "kinetic", "potential", "total_energy", "max_strain", "seconds"};
+  return {"contacts_found", "contacts_active", "swept", "sticking", "sliding", "moved_back", "max_penetration",
+          "max_normal_force", "normal_force", "kinetic", "potential", "total_energy", "max_strain", "seconds"};
 }
 
 }  // namespace cl::lab14

@@ -63,6 +63,7 @@ struct StepReport {
   // the force that made the projection's move over the step, λ_n = d / (w Δt²)
   // (d its normal correction) and λ_t = −(friction correction) / (w Δt²).
   std::vector<ContactMultipliers> multipliers;
+  int active = 0;                 // contacts that acted: λ_n > 0 (the others were found but needed no push)
   int swept = 0;                  // contacts whose particle passed through the collider (Contact::swept)
   int sticking = 0;               // active contacts (λ_n > 0) held inside the friction cone
   int sliding = 0;                // active contacts on the cone's edge (or μ = 0)
@@ -134,8 +135,10 @@ struct RunResult {
   double energy_end = 0.0;
   double max_penetration = 0.0;     // over every step's end (not the scene's start, frame 0), m
   double max_normal_force = 0.0;    // over every step, N
-  long long contacts = 0;           // Σ over steps
+  long long contacts = 0;           // Σ over steps of the contacts found (StepReport::contacts)
+  long long active = 0;             // Σ over steps of the active ones (StepReport::active)
   long long swept = 0, sticking = 0, sliding = 0;
+  long long moved_back = 0;         // Σ over steps of StepReport::moved_back (particle-steps)
   std::string problem;
   int problem_step = -1;
   bool step_failed = false;
@@ -152,9 +155,10 @@ RunResult run_steps(Particles& particles, ContactStepper& stepper, const std::ve
                     const std::vector<Collider>& colliders, int steps, const FrameCallback& on_frame = nullptr,
                     const FrameOutput& output = {});
 
-// The per-step CSV's columns: contacts, swept, sticking, sliding,
-// max_penetration (m), max_normal_force, normal_force (N), kinetic, potential,
-// total_energy (J), max_strain, seconds.
+// The per-step CSV's columns: contacts_found (detected, active or not),
+// contacts_active (λ_n > 0), swept, sticking, sliding, moved_back (the last
+// resort's particles), max_penetration (m), max_normal_force, normal_force
+// (N), kinetic, potential, total_energy (J), max_strain, seconds.
 std::vector<std::string> step_columns();
 
 }  // namespace cl::lab14

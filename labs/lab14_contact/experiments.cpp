@@ -69,7 +69,7 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
     if (loaded.particles.inv_mass[i] > 0.0) mass += 1.0 / loaded.particles.inv_mass[i];
   }
   CsvTable table({"method", "friction", "iterations", "steps_done", "max_penetration", "energy_start", "energy_end",
-                  "seconds_per_step", "rest_time", "max_normal_force", "status"});
+                  "seconds_per_step", "rest_time", "max_normal_force", "moved_back", "status"});
   std::printf("%s --drape: scene %s, K = %d, %d steps of %.4g s\n", lab_name, describe(loaded).c_str(),
               options.iterations, loaded.steps, loaded.dt);
   std::printf("  %-12s %5s %14s %14s %14s %12s\n", "method", "mu", "penetration m", "energy end J", "s per step",
@@ -95,7 +95,7 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
       const bool rested = rest_from >= 0 && run.problem.empty();
       table.add_row({std::string(method), mu, static_cast<long long>(options.iterations),
                      static_cast<long long>(run.steps_done), run.max_penetration, run.energy_start, run.energy_end,
-                     per_step, cell_if(rested, rest_from * scene.dt), run.max_normal_force,
+                     per_step, cell_if(rested, rest_from * scene.dt), run.max_normal_force, run.moved_back,
                      run.problem.empty() ? std::string("ok") : run.problem});
       std::printf("  %-12s %5.2f %14.3e %14.6g %14.3e %12s\n", method, mu, run.max_penetration, run.energy_end,
                   per_step, rested ? std::to_string(rest_from * scene.dt).substr(0, 6).c_str() : "-");

@@ -45,7 +45,8 @@ Scene incline_scene(double degrees, double friction, int steps);
 // --frictions (--iterations, --steps): the worst penetration, the final
 // kinetic + potential energy, the time per step, and the time to rest (the
 // first step from which the kinetic energy per kilogram stays below 1e-4
-// J/kg to the end; empty when it never does) -> OUT/drape.csv, a table.
+// J/kg to the end; empty when it never does) and the particle-steps the
+// last resort moved back (StepReport::moved_back) -> OUT/drape.csv, a table.
 int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab);
 
 // Experiment 2: for each method, each μ of --frictions and each θ of

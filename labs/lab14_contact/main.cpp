@@ -1,7 +1,8 @@
 // lab14_contact: a scene with colliders, stepped by PBD (lab 04), XPBD (lab 08)
 // or lab 07's constrained step with the contact rows solved by projected
-// Gauss-Seidel: per_step.csv (contacts, penetration, normal forces, stick and
-// slide, energy) and the run summary. The experiments (experiments.cpp):
+// Gauss-Seidel: per_step.csv (contacts found and active, penetration, normal
+// forces, stick and slide, particles moved back, energy) and the run summary.
+// The experiments (experiments.cpp):
 //   --drape     every method × --frictions on the scene: drape.csv
 //   --incline   the stick/slip boundary against μ per method: incline.csv
 //   --live      the scene steps beside a page in the browser (./course live)
@@ -59,7 +60,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::lab14::RunResult result =
       cl::lab14::run_steps(particles, stepper, scene.springs, scene.colliders, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
-  const double per_step = result.steps_done > 0 ? static_cast<double>(result.contacts) / result.steps_done : 0.0;
+  const double steps_done = result.steps_done > 0 ? result.steps_done : 1.0;
+  const double found_per_step = static_cast<double>(result.contacts) / steps_done;
+  const double active_per_step = static_cast<double>(result.active) / steps_done;
 
   std::printf("%s: scene %s, %zu collider(s), %s, K = %d, friction %s, %d steps of %.4g s\n", kLab,
               cl::describe(scene).c_str(), scene.colliders.size(), options.method.c_str(), options.iterations,
@@ -68,8 +71,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     cl::print_stopped(result.step_failed ? "STOPPED" : "DIVERGED", "step", result.problem_step, scene.dt,
                       result.problem);
   }
-  std::printf("  contacts %.1f per step (%lld swept), %lld sticking and %lld sliding contact-steps\n", per_step,
-              result.swept, result.sticking, result.sliding);
+  std::printf("  contacts per step: %.1f found, %.1f active (λ_n > 0); %lld swept, %lld sticking and %lld sliding "
+              "contact-steps; %lld particle-steps moved back from inside a collider\n",
+              found_per_step, active_per_step, result.swept, result.sticking, result.sliding, result.moved_back);
   std::printf("  worst penetration %.3e m, largest normal force %.6g N, max strain %.3e\n", result.max_penetration,
               result.max_normal_force, strain.max);
   cl::print_energies("  energy: ", cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
@@ -81,7 +85,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     cl::RunSummary summary = cl::stepping_summary(kLab, options.method, scene, particles, strain, result.seconds);
     summary.iterations = options.iterations;
     if (lab.friction) summary.extra["friction"] = *lab.friction;
-    summary.extra["contacts_per_step"] = per_step;
+    summary.extra["contacts_found_per_step"] = found_per_step;
+    summary.extra["contacts_active_per_step"] = active_per_step;
+    summary.extra["contacts_per_step"] = found_per_step;  // the name before contacts_found_per_step (handout)
+    summary.extra["moved_back"] = result.moved_back;
     summary.extra["swept_contacts"] = result.swept;
     summary.extra["sticking"] = result.sticking;
     summary.extra["sliding"] = result.sliding;
