@@ -7,6 +7,7 @@
 //   --sweep-mass-ratios 1,10,...   largest stable dt of a heavy chain against its
 //                                  mass ratio, with and without K_g -> stability.csv,
 //                                  stability_runs.csv
+//   --live [PORT]                  the scene's steps beside a page in the browser (run.cpp)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +25,7 @@
 #include "common/summary.h"
 #include "experiments.h"
 #include "geometric_stiffness.h"
+#include "run.h"
 #include "stable_step.h"
 #include "step.h"
 
@@ -31,6 +33,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab09::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 std::string describe_constraints_and_masses(const cl::Scene& scene) {
   std::ostringstream text;
@@ -138,6 +141,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 }
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
+  if (live.on && !lab.sweep_mass_ratios.empty()) throw cl::InputError("--live: not with --sweep-mass-ratios");
+  if (live.on) return cl::lab09::run_live_scene(kLab, CL_LAB_SCENE_DIR, options, lab, live);
   if (lab.sweep_mass_ratios.empty()) return run_one(options, lab);
   cl::refuse_run_flags(options, "only for one run (not with --sweep-mass-ratios)",
                        "a sweep writes stability.csv, not a run summary");
@@ -158,6 +163,7 @@ int main(int argc, char** argv) {
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagDt | cl::kFlagSteps | cl::kFlagOut |
                              cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--geometric-stiffness", lab.geometric_stiffness,
                  "add K_g to the step (on) or not (off: lab 07's step)")
       .one_of({"on", "off"})

@@ -6,6 +6,7 @@
 //             max strain reaches each --targets value, for every scene of
 //             --sweep-scenes and level count of --sweep-levels
 //             -> convergence.csv (every sweep) and to_target.csv
+//   --live [PORT]  the scene's frames beside a page in the browser
 #include <cstdio>
 #include <optional>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include "common/cli.h"
 #include "common/driver.h"
 #include "common/hierarchy.h"
+#include "common/live.h"
 #include "common/metrics.h"
 #include "common/output.h"
 #include "common/summary.h"
@@ -26,6 +28,7 @@ namespace {
 
 constexpr const char* kLab = CL_LAB_NAME;
 using cl::lab10::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 std::string describe_cloth(const cl::Scene& scene) {
   std::ostringstream text;
@@ -43,6 +46,26 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   settings.dt = scene.dt;
   settings.gravity = scene.gravity;
   settings.iterations = cl::lab10::per_level(lab, lab.levels);
+  if (live.on) {  // levels, a pin or a held particle change the hierarchy's masses: it is built again
+    cl::refuse_run_flags(options, "not with --live (the page shows every frame)", "");
+    const int most = cl::max_levels(scene.grid_nx, scene.grid_ny);
+    cl::LiveRun run{kLab, cl::lab10::method_name(lab.levels),
+                    {{"K", "sweeps per level", 0, 200, 1.0 * settings.iterations.front(), true},
+                     {"dt", "s", 1e-4, 0.05, scene.dt}, {"levels", "", 1, 1.0 * most, 1.0 * lab.levels, true}}};
+    const Eigen::Matrix3Xd rest = scene.particles.x;  // the coarse levels' rest lengths
+    std::optional<cl::ClothHierarchy> live_hierarchy;
+    run.changed = [&](const cl::Knobs& knobs) {
+      live_hierarchy.emplace(cl::build_cloth_hierarchy(scene.grid_nx, scene.grid_ny, rest, scene.particles.inv_mass,
+                                                       scene.springs, knobs.integer(2)));
+    };
+    run.step = [&](const cl::Knobs& knobs) {
+      settings.iterations.assign(static_cast<std::size_t>(knobs.integer(2)), knobs.integer(0));
+      settings.dt = knobs[1];
+      cl::lab10::hpbd_step(scene.particles, *live_hierarchy, settings);
+      return cl::StepVerdict{};
+    };
+    return cl::run_live(scene, live, run, options.summary);
+  }
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const std::string frames_dir = cl::join_path(options.out, "frames");
   if (options.frames > 0) cl::ensure_directory(frames_dir);
@@ -100,10 +123,14 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   if (lab.converge) {
+    if (live.on) throw cl::InputError("--live: not with --converge");
     cl::refuse_run_flags(options, "not with --converge", "");
     return cl::lab10::run_converge(kLab, CL_LAB_SCENE_DIR, options, lab);
   }
   if (!lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --converge");
+  if (live.on && lab.iterations_per_level.size() > 1) {
+    throw cl::InputError("--iterations-per-level: one count with --live (its knob K turns every level's)");
+  }
   if (!lab.sweep_levels.empty()) throw cl::InputError("--sweep-levels: only with --converge");
   if (options.frames > 0 && options.out.empty()) {
     throw cl::InputError("--frames: needs --out DIR for the trajectory and the OBJ files");
@@ -126,6 +153,7 @@ int main(int argc, char** argv) {
       .description("keep every N-th frame in OUT/trajectory.json and .bin (./course view OUT) and write its OBJ "
                    "mesh into OUT/frames/");
   LabOptions lab;
+  cl::add_live_option(app, live);
   app.add_option("--levels", lab.levels, "levels of the hierarchy (1: plain Gauss-Seidel PBD)")
       .range(1, 16)
       .capture_default_str();

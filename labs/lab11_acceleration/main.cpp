@@ -6,65 +6,37 @@
 //                  convergence.csv (objective_error = (g − g*)/g*, g* lab 06's
 //                  Newton minimum; max_strain for PBD) and a table of the
 //                  iterations and seconds to each target
+//   --live [PORT]  the scene's steps beside a page in the browser (run.cpp)
 #include <cmath>
 #include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "accelerated.h"
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/driver.h"
 #include "common/output.h"
 #include "common/summary.h"
+#include "run.h"
 
 namespace {
 
 using cl::lab11::Method;
 constexpr const char* kLab = CL_LAB_NAME;
 
-struct LabOptions {
-  cl::lab11::Settings settings;
-  bool estimate = true;  // no --rho: measure it on the scene
-  bool convergence = false;
-  std::vector<std::string> sweep_scenes;
-  double strain_target = 1e-3;
-  int estimate_iterations = 400;
-};
-
-// The scenes of a run (--scene) or of --convergence (--sweep-scenes), each
-// refused when the chosen method minimises g and a spring is hard.
-std::vector<cl::Scene> load(const cl::CommonOptions& options, const std::vector<std::string>& names, Method method) {
-  std::vector<cl::Scene> scenes = cl::load_scenes(options, names, CL_LAB_SCENE_DIR);
-  for (const cl::Scene& scene : scenes) {
-    if (!cl::lab11::minimises_objective(method)) break;
-    cl::require_finite_springs(scene,
-                               std::string(cl::lab11::method_name(method)) + " needs finite springs (or a PBD method)");
-  }
-  return scenes;
-}
-
-// --rho, or ρ measured on the scene's first step (Wang: once per scene); 0 without Chebyshev.
-double rho_for(cl::lab11::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
-  if (!lab.estimate || (method != Method::kPdChebyshev && method != Method::kJacobiChebyshev)) return lab.settings.rho;
-  cl::lab11::Settings settings = lab.settings;
-  settings.gravity = scene.gravity;
-  const double rho = solver.estimate_rho(scene.particles, method, settings, lab.estimate_iterations);
-  if (rho < 1.0) return rho;
-  std::printf("  estimated rho %.6f >= 1 (the plain iteration does not converge): no acceleration (rho 0)\n", rho);
-  return 0.0;
-}
+using cl::lab11::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab11::method_from_name(options.method);
-  cl::Scene scene = std::move(load(options, {}, method).front());
+  cl::Scene scene = std::move(cl::lab11::load(options, {}, method, CL_LAB_SCENE_DIR).front());
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   cl::lab11::Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
   settings.iterations = options.iterations;
-  settings.rho = rho_for(solver, scene, method, lab);
+  settings.rho = cl::lab11::rho_for(solver, scene, method, lab);
   cl::CsvTable table({"step", "iteration", "objective", "max_strain", "omega", "restarted", "seconds"});
   const cl::lab11::RunIterationCallback on_iteration = [&](int step, const cl::lab11::IterationRecord& r) {
     table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.max_strain,
@@ -105,7 +77,8 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   cl::refuse_run_flags(options, "", "--convergence writes CSV files, not a run summary");
   const Method method = cl::lab11::method_from_name(options.method);
   const bool pd = cl::lab11::minimises_objective(method);
-  const std::vector<cl::Scene> scenes = load(options, lab.sweep_scenes, method);  // every refusal before any output
+  // Every refusal before any output.
+  const std::vector<cl::Scene> scenes = cl::lab11::load(options, lab.sweep_scenes, method, CL_LAB_SCENE_DIR);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   cl::CsvTable table({"scene", "method", "rho", "history", "iteration", "objective", "objective_error", "max_strain",
                       "omega", "restarted", "seconds", "setup_seconds"});
@@ -114,7 +87,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
     cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
     cl::lab11::Settings settings = lab.settings;
     settings.gravity = scene.gravity;
-    settings.rho = rho_for(solver, scene, method, lab);
+    settings.rho = cl::lab11::rho_for(solver, scene, method, lab);
     double best = 0.0;  // g*: lab 06's Newton to round-off
     if (pd) {
       cl::lab11::Settings newton = settings;
@@ -170,6 +143,7 @@ int main(int argc, char** argv) {
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   double rho = -1.0;
   const std::vector<std::string> chebyshev{"pd-chebyshev", "jacobi-chebyshev"};
   app.add_option("--rho", rho, "the spectral radius for Chebyshev, in [0, 1) (default: estimated per scene)")
@@ -195,6 +169,8 @@ int main(int argc, char** argv) {
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;
     if (!lab.convergence && !lab.sweep_scenes.empty()) throw cl::InputError("--sweep-scenes: only with --convergence");
     if (lab.convergence) cl::refuse_run_flags(options, "only for a run of steps (not with --convergence)", "");
+    if (live.on && lab.convergence) throw cl::InputError("--live: not with --convergence (it runs one step)");
+    if (live.on) return cl::lab11::run_live_scene(kLab, CL_LAB_SCENE_DIR, options, lab, live);
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
 }

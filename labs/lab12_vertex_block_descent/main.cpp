@@ -7,6 +7,7 @@
 //                  Newton minimum, per sweep) and a table of the sweeps and
 //                  seconds to each target
 //   --stability    experiment 2: the table of k × Δt × K on the scene (stability.csv)
+//   --live [PORT]  the scene's steps beside a page in the browser (run.cpp)
 #include <omp.h>
 
 #include <cmath>
@@ -20,33 +21,15 @@
 #include "common/output.h"
 #include "common/summary.h"
 #include "descent.h"
+#include "run.h"
 
 namespace {
 
 using cl::lab12::Method;
 constexpr const char* kLab = CL_LAB_NAME;
 
-struct LabOptions {
-  cl::lab12::Settings settings;
-  std::string init = "adaptive";
-  bool estimate = true;  // no --rho: measure it on the scene
-  int estimate_iterations = 400;
-  int threads = 1;
-  bool convergence = false, stability = false;
-  std::vector<std::string> sweep_scenes;
-};
-
-// --rho, or ρ of plain VBD measured on the scene's first step; 0 for plain VBD.
-double rho_for(const cl::lab12::Solver& solver, const cl::Scene& scene, Method method, const LabOptions& lab) {
-  if (method != Method::kVbdChebyshev) return 0.0;
-  if (!lab.estimate) return lab.settings.rho;
-  cl::lab12::Settings settings = lab.settings;
-  settings.gravity = scene.gravity;
-  const double rho = solver.estimate_rho(scene.particles, settings, lab.estimate_iterations);
-  if (rho < 1.0) return rho;
-  std::printf("  estimated rho %.6f >= 1 (plain VBD does not converge here): no acceleration (rho 0)\n", rho);
-  return 0.0;
-}
+using cl::lab12::LabOptions;
+cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the browser (./course live)
 
 int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab12::method_from_name(options.method);
@@ -57,7 +40,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   cl::lab12::Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
   settings.iterations = options.iterations;
-  settings.rho = rho_for(solver, scene, method, lab);
+  settings.rho = cl::lab12::rho_for(solver, scene, method, lab);
   cl::CsvTable table({"step", "iteration", "objective", "omega", "restarted", "seconds"});
   const cl::lab12::RunIterationCallback on_iteration = [&](int step, const cl::lab12::IterationRecord& r) {
     table.add_row({static_cast<long long>(step), static_cast<long long>(r.iteration), r.objective, r.omega,
@@ -106,7 +89,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
     const cl::lab12::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
     cl::lab12::Settings settings = lab.settings;
     settings.gravity = scene.gravity;
-    settings.rho = rho_for(solver, scene, method, lab);
+    settings.rho = cl::lab12::rho_for(solver, scene, method, lab);
     settings.iterations = options.iterations;
     // g*: lab 06's Newton to round-off, from the same prediction.
     cl::lab06::Solver newton(solver.problem(), cl::lab06::Method::kNewton);
@@ -172,6 +155,7 @@ int main(int argc, char** argv) {
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
   LabOptions lab;
+  cl::add_live_option(app, live);
   double rho = -1.0;
   app.add_option("--init", lab.init, "the first iterate: inertia (y) or adaptive (Chen et al. 2024)")
       .one_of({"inertia", "adaptive"}).capture_default_str();
@@ -194,6 +178,8 @@ int main(int argc, char** argv) {
     if (lab.convergence || lab.stability) cl::refuse_run_flags(options, "only for a run of steps", "");
     lab.settings.init = cl::lab12::init_from_name(lab.init);
     omp_set_num_threads(lab.threads);
+    if (live.on && (lab.convergence || lab.stability)) throw cl::InputError("--live: not with --convergence or --stability");
+    if (live.on) return cl::lab12::run_live_scene(kLab, CL_LAB_SCENE_DIR, options, lab, live);
     if (lab.stability) return run_stability(options, lab);
     return lab.convergence ? run_convergence(options, lab) : run_steps(options, lab);
   });
