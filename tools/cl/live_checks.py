@@ -52,9 +52,10 @@ class DevTools:
             raise RuntimeError(f"{expression[:60]}: {result['exceptionDetails'].get('text')}")
         return result["result"].get("value")
 
-    def mouse(self, kind, x, y):
+    def mouse(self, kind, x, y, modifiers=0):
+        """A left-button mouse event at CSS px (x, y); modifiers 8: Shift held."""
         self.call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left",
-                  buttons=0 if kind == "mouseReleased" else 1, clickCount=1)
+                  buttons=0 if kind == "mouseReleased" else 1, clickCount=1, modifiers=modifiers)
 
     def status(self):
         text = self.js("document.body.getAttribute('data-status')")
@@ -146,12 +147,37 @@ def second_client(port, token, particle):
     return [f"the second client never saw particle {particle} held"]
 
 
+def pin_and_reset(page, particle, scene_pinned):
+    """Shift-click pins `particle` (the simulation lists it pinned and it stays
+    where it is while the run goes on); reset brings back the scene's first
+    state (frame 0 again, its own pins only). Returns what went wrong."""
+    problems = []
+    page.js("document.getElementById('pause').click()")
+    page.wait("the run paused", lambda: page.status()["paused"])
+    at = page.js(f"CLLive.screenOf(CLLive.position({particle}))")
+    page.mouse("mousePressed", *at, modifiers=8)
+    page.mouse("mouseReleased", *at, modifiers=8)
+    page.wait(f"particle {particle} pinned", lambda: particle in page.status()["pinned"])
+    where, frame = page.js(f"CLLive.position({particle})"), page.status()["frame"]
+    page.js("document.getElementById('pause').click()")
+    page.wait("10 frames with the particle pinned", lambda: page.status()["frame"] >= frame + 10)
+    if math.dist(page.js(f"CLLive.position({particle})"), where) > 1e-6:
+        problems.append(f"pin: particle {particle} moved while pinned")
+    frame = page.status()["frame"]
+    page.js("document.getElementById('reset').click()")
+    status = page.wait("the reset", lambda: page.status()["frame"] < frame and page.status())
+    if sorted(status["pinned"]) != sorted(scene_pinned):
+        problems.append(f"reset: pinned {status['pinned']}, not the scene's {scene_pinned}")
+    return problems
+
+
 def drive(page, process, port, token):
     """The checks on the page; a list of what went wrong."""
     problems = []
     page.wait("the first frame drawn", lambda: page.js("document.body.getAttribute('data-ready')") == "1")
     page.js("document.getElementById('pause').click()")
     page.wait("the run paused", lambda: (page.status() or {}).get("paused"))
+    scene_pinned = page.status()["pinned"]
     n = page.js("CLLive.mesh().particles")
     x = page.js(f"Array.from({{length: {n}}}, function (_, p) {{ return CLLive.position(p); }})")
     particle = min(range(n), key=lambda p: x[p][0] + x[p][1])  # the bottom-left corner of a hanging curtain
@@ -174,6 +200,9 @@ def drive(page, process, port, token):
     if off > 5e-3 or abs(moved - 0.2) > 5e-3:
         problems.append(f"drag: particle {particle} held at {held}, {moved:.4f} m from where it was (0.2 asked), "
                         f"{off:.4f} m from the target {target} (tolerance 5 mm: a pixel)")
+    marked = page.js("document.body.getAttribute('data-held')")  # the ball the page draws on it
+    if marked != str(particle):
+        problems.append(f"drag: the page marks {marked!r} as held, not {particle}")
     page.js("document.getElementById('pause').click()")  # resume, still holding
     frame = page.status()["frame"]
     page.wait("30 frames with the particle held", lambda: page.status()["frame"] >= frame + 30)
@@ -183,6 +212,8 @@ def drive(page, process, port, token):
                         f"after 30 frames (rest {rest:.4f} m): the cloth did not follow")
     page.mouse("mouseReleased", *end)
     page.wait("the release", lambda: not page.status()["held"])
+    page.wait("the held mark gone", lambda: page.js("document.body.getAttribute('data-held')") == "")
+    problems += pin_and_reset(page, particle, scene_pinned)
 
     page.js("var k = document.getElementById('knob-K'); k.value = 3; k.dispatchEvent(new Event('change'));")
     page.wait("a frame stepped with K = 3", lambda: page.status()["step_knobs"]["K"] == 3)
@@ -258,6 +289,6 @@ def check_live(checks):
     problems += [f"stderr: {line}" for line in err.splitlines()
                  if "malformed JSON" not in line and "refused" not in line]
     checks.record(not problems, f"live lab 04 on a 16² curtain in headless Chromium ({time.monotonic() - started:.0f} s): "
-                  "a drag of 0.2 m held and followed, K turned in the page, a malformed message refused while frames "
-                  "kept coming, a second client gone mid-drag, no token and a foreign Origin refused, stop: exit 0",
+                  "a drag of 0.2 m held (and marked) and followed, a shift-click pin, reset, K turned in the page, a "
+                  "malformed message refused while frames kept coming, a second client gone mid-drag, no token and a foreign Origin refused, stop: exit 0",
                   problems)
