@@ -8,7 +8,9 @@
 //
 // Writes DIR/trade.csv (one row per run), DIR/trade_scenes.csv (the scenes and
 // their reference steps), DIR/trade_fastest.csv (the fastest method to each
-// strain target) and DIR/trade_scaling.csv (time per iteration against size).
+// strain target) and DIR/trade_scaling.csv (time per iteration against size);
+// the drape-N scenes (lab 14's contact methods against the constrained step
+// at convergence, trade_contact.cpp) DIR/trade_contact.csv.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -36,6 +38,7 @@
 #include "labs/lab06_projective_dynamics/simulation.h"
 #include "labs/lab13_constrained_newton/iteration.h"
 #include "methods.h"
+#include "trade_contact.h"
 
 namespace {
 
@@ -61,8 +64,9 @@ const std::vector<std::string> kTradeMethods{"gs-pbd", "jacobi-pbd", "hpbd", "xp
                                              "pd-chebyshev", "pd-lbfgs", "jacobi-chebyshev", "vbd",
                                              "vbd-chebyshev", "constrained-newton",
                                              "constrained-newton-drop"};
-const std::vector<std::string> kAllScenes{"rope-100", "curtain-16", "curtain-32", "curtain-64", "curtain-128"};
-const std::vector<std::string> kQuickScenes{"rope-100", "curtain-16", "curtain-32"};
+const std::vector<std::string> kAllScenes{"rope-100", "curtain-16", "curtain-32", "curtain-64", "curtain-128",
+                                          "drape-32"};
+const std::vector<std::string> kQuickScenes{"rope-100", "curtain-16", "curtain-32", "drape-16"};
 
 // The shared scenes, with every spring of stiffness k (N/m). The gravity has a
 // breeze along z (as lab 06's curtains) so that every spring is in tension
@@ -78,13 +82,13 @@ cl::Scene make_scene(const std::string& name, double stiffness) {
   } else if (name.rfind("curtain-", 0) == 0) {
     const std::string n = name.substr(8);
     if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos || n.size() > 4) {
-      throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100 or curtain-N, N >= 3)");
+      throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100, curtain-N or drape-N, N >= 3)");
     }
     text = R"({"name": ")" + name + "\", " + common + R"("cloth": {"nx": )" + n + R"(, "ny": )" + n +
            R"(, "width": 1, "height": 1, "mass": 1, "pin": ["top"], "springs": ["structural", "shear"], )"
            R"("triangles": false, "stiffness": )" + k + "}}";
   } else {
-    throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100 or curtain-N, N >= 3)");
+    throw cl::InputError("--scenes: unknown scene '" + name + "' (rope-100, curtain-N or drape-N, N >= 3)");
   }
   return cl::parse_scene(text, "bench scene " + name);
 }
@@ -454,17 +458,35 @@ void mark_front(std::vector<Run>& runs, std::size_t begin) {
 }
 
 int run(const Options& options) {
-  const std::vector<std::string> scenes = options.scenes.empty() ? (options.quick ? kQuickScenes : kAllScenes)
-                                                                 : options.scenes;
-  std::vector<std::string> methods = options.methods.empty() ? kTradeMethods : options.methods;
-  for (const std::string& method : methods) {
+  // The drape-N scenes are the contact trade's (trade_contact.cpp), with the contact methods.
+  std::vector<std::string> scenes, contact_scenes;
+  for (const std::string& name : options.scenes.empty() ? (options.quick ? kQuickScenes : kAllScenes) : options.scenes) {
+    const bool contact_scene = cl::bench::is_contact_scene(name);
+    // A build without lab 14's reference (a student release before its week) leaves the drape out of the defaults.
+    if (contact_scene && options.scenes.empty() && cl::bench::contact_methods().empty()) continue;
+    (contact_scene ? contact_scenes : scenes).push_back(name);
+  }
+  std::vector<std::string> methods, contact_methods;
+  for (const std::string& method : options.methods.empty() ? kTradeMethods : options.methods) {
     try {
-      cl::bench::method_info(method);
+      (cl::bench::models_colliders(cl::bench::method_info(method)) ? contact_methods : methods).push_back(method);
     } catch (const std::invalid_argument& error) {
       throw cl::InputError(std::string("--methods: ") + error.what());
     }
   }
+  if (!options.methods.empty() && contact_methods.empty() && !contact_scenes.empty()) {
+    throw cl::InputError("--methods: the drape scenes run only contact-pbd, contact-xpbd or contact-constrained");
+  }
+  if (!options.methods.empty() && methods.empty() && !scenes.empty()) {
+    throw cl::InputError("--methods: " + scenes.front() + " has no colliders; the contact methods run on drape-N");
+  }
+  cl::bench::ContactTradeOptions contact;
+  contact.scenes = contact_scenes;
+  contact.methods = contact_methods;
+  contact.quick = options.quick;
+  contact.out = options.out;
   const int repeats = options.repeats > 0 ? options.repeats : (options.quick ? 3 : 5);
+  contact.repeats = repeats;
   const int horizon = options.horizon > 0 ? options.horizon : (options.quick ? 10 : 20);
   const int warmup = options.warmup > 0 ? options.warmup : (options.quick ? 5 : 10);
   const double cap = options.step_cap > 0.0 ? options.step_cap : (options.quick ? 0.05 : 0.3);
@@ -475,9 +497,13 @@ int run(const Options& options) {
   cl::set_blas_threads(options.threads);  // CHOLMOD's BLAS too: serial methods, timed side by side
 #endif
 
-  std::printf("trade: %zu scenes x %zu methods, k = %g N/m, %d repeats, horizon %d steps, warm-up %d steps, "
-              "K grows while a step takes < %s, %d thread(s)\n",
-              scenes.size(), methods.size(), options.stiffness, repeats, horizon, warmup, time_text(cap).c_str(), options.threads);
+  if (!contact_scenes.empty()) cl::bench::check_contact_trade(contact);
+  if (!scenes.empty()) {
+    std::printf("trade: %zu scenes x %zu methods, k = %g N/m, %d repeats, horizon %d steps, warm-up %d steps, "
+                "K grows while a step takes < %s, %d thread(s)\n",
+                scenes.size(), methods.size(), options.stiffness, repeats, horizon, warmup, time_text(cap).c_str(),
+                options.threads);
+  }
   std::fflush(stdout);
   const cl::Timer total;
   Progress progress;
@@ -626,6 +652,8 @@ int run(const Options& options) {
     mark_front(runs, first_run);
   }
   progress.clear();
+  if (!contact_scenes.empty()) cl::bench::run_contact_trade(contact);
+  if (scenes.empty()) return 0;  // only drape scenes: trade_contact.csv is their output
 
   // ---------------------------------------------------------------- output
   cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
@@ -764,11 +792,14 @@ int main(int argc, char** argv) {
   Options options;
   app.add_flag("--quick", options.quick, "CI size: rope-100, curtain-16 and -32, fewer iterations, repeats and steps");
   app.add_option("--out", options.out, "folder for the CSV files").capture_default_str();
-  app.add_option("--scenes", options.scenes, "rope-100, curtain-N (default: rope-100 and curtains 16 to 128)")
+  app.add_option("--scenes", options.scenes,
+                 "rope-100, curtain-N, drape-N (lab 14's drape: the contact methods; default: rope-100, curtains 16 to "
+                 "128, drape-32)")
       .delimiter(',');
   app.add_option("--methods", options.methods,
                  "gs-pbd, jacobi-pbd, hpbd, xpbd, pd, newton, kkt, schur, schur-kg, pd-chebyshev, pd-lbfgs, jacobi-chebyshev, "
-                 "vbd, vbd-chebyshev, constrained-newton, constrained-newton-drop")
+                 "vbd, vbd-chebyshev, constrained-newton, constrained-newton-drop; on drape-N: contact-pbd, contact-xpbd, "
+                 "contact-constrained")
       .delimiter(',');
   app.add_option("--stiffness", options.stiffness, "every spring's stiffness, N/m")
       .positive()
