@@ -47,7 +47,8 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   solver.emplace(scene.particles.inv_mass, scene.springs, scene.dt);
   settings.rho = rho_for(*solver, scene, method, lab);
   const bool chebyshev = method == Method::kPdChebyshev || method == Method::kJacobiChebyshev;
-  std::vector<Knob> declared{{"K", "iterations", 0, 100, 1.0 * options.iterations, true},
+  const char* unit = minimises_objective(method) ? "iterations" : "sweeps";
+  std::vector<Knob> declared{{"K", unit, 0, 100, 1.0 * options.iterations, true},
                              {"dt", "s", 1e-4, 0.05, scene.dt}};
   if (chebyshev) declared.push_back({"rho", "", 0, 0.9999, settings.rho});
   if (method == Method::kPdLbfgs) declared.push_back({"history", "pairs", 0, 50, 1.0 * settings.history, true});
