@@ -129,7 +129,8 @@ def first_errors(output):
         if start > 0 and re.search(r"In (member )?function|In file included", lines[start - 1]):
             start -= 1
         shown = lines[start:start + ERROR_LINES]
-    return [line.replace(str(ROOT) + "/", "") for line in shown]
+    # A path relative to the build folder (ccache's base_dir in ./course test) reads from the root too.
+    return [re.sub(r"(^|[\s(])\.\./(?=\w)", r"\1", line.replace(str(ROOT) + "/", "")) for line in shown]
 
 
 def student_warnings(lab, output):
