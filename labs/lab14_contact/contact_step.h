@@ -46,6 +46,9 @@ struct StepSettings {
 //     collider (the discrete test at end_i alone would see no penetration);
 //   - discrete: otherwise, when s(end_i) < margin: the contact is at the
 //     closest surface point of end_i, q = end_i − s n.
+// Either kind is dropped when its surface point lies more than 1e-9 m inside
+// another collider (overlapping colliders: a buried piece of surface, whose
+// half-space can face the other's; README.md, "Overlapping colliders").
 // μ is `friction` when set, else the collider's. Contacts are listed by
 // particle, then collider. Pinned particles have none.
 std::vector<Contact> detect_contacts(const Eigen::Matrix3Xd& start, const Eigen::Matrix3Xd& end,
