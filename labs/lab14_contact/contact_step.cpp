@@ -189,18 +189,19 @@ std::vector<Contact> detect_contacts(const Eigen::Matrix3Xd& start, const Eigen:
     for (std::size_t c = 0; c < colliders.size(); ++c) {
       std::optional<Contact> contact = contact_of(colliders[c], start.col(i), end.col(i), margin);
       if (!contact) continue;
-      // Not a contact when its surface point lies inside another collider
-      // (overlapping colliders, a sphere sunk into the floor): that part of
-      // the surface is no boundary of the free space, and its half-space can
-      // face the other collider's, as the bottom of the sunk sphere faces the
-      // floor, so that only a far tip of their thin wedge meets both (the
-      // converged constrained step threw a particle 14 m, bench/README.md).
-      // The boundary the particle must reach is elsewhere, and B's contact
-      // is listed: a swept entry point on A inside B lies past the segment's
-      // entry into B (for a start outside B), and an end outside A within
-      // the margin whose nearest point on A is inside B is nearer still to B
-      // (s is 1-Lipschitz). What is left (an end inside A whose nearest
-      // point on A is inside B, B beyond the margin) is the last resort's.
+      // Not a contact when its surface point on this collider A lies inside
+      // another, B (overlapping colliders, a sphere sunk into the floor): that
+      // part of the surface is no boundary of the free space, and its
+      // half-space can face the other collider's, as the bottom of the sunk
+      // sphere faces the floor, so that only a far tip of their thin wedge
+      // meets both (the converged constrained step threw a particle 14 m,
+      // bench/README.md). The boundary the particle must reach is elsewhere,
+      // and B's contact is listed: a swept entry point on A inside B lies past
+      // the segment's entry into B (for a start outside B), and an end outside
+      // A within the margin whose nearest point on A is inside B is nearer
+      // still to B (s is 1-Lipschitz). What is left (an end inside A whose
+      // nearest point on A is inside B, B beyond the margin) is the last
+      // resort's when the particle started outside every collider.
       const bool inside_other = [&] {
         for (std::size_t o = 0; o < colliders.size(); ++o) {
           if (o != c && surface_distance(colliders[o], contact->point).distance < -kInsideOther) return true;
