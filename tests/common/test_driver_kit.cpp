@@ -13,12 +13,13 @@
 #include "common/csv.h"
 #include "common/driver.h"
 #include "common/output.h"
+#include "tests/support/scratch.h"
 
 namespace {
 
-// A scene file in the working directory; its path.
-std::string scene_file(const std::string& name, int steps) {
-  const std::string path = "driver_kit_" + name + ".json";
+// A scene file in `scratch`; its path.
+std::string scene_file(const cl::test::ScratchDir& scratch, const std::string& name, int steps) {
+  const std::string path = scratch.file(name + ".json");
   cl::write_file_atomic(path, R"({"name": ")" + name + R"(", "dt": 0.01, "steps": )" + std::to_string(steps) +
                                   R"(, "particles": [{"x": [0, 0, 0]}, {"x": [1, 0, 0]}], "springs": [{"i": 0, "j": 1}]})");
   return path;
@@ -27,21 +28,23 @@ std::string scene_file(const std::string& name, int steps) {
 }  // namespace
 
 TEST_CASE("load_scenes loads the sweep's scenes in order, or --scene alone, with --steps applied", "[common][driver]") {
+  const cl::test::ScratchDir scratch("driver_kit");
   cl::CommonOptions options;
-  options.scene = scene_file("alone", 5);
+  options.scene = scene_file(scratch, "alone", 5);
   options.steps = 3;
   const std::vector<cl::Scene> alone = cl::load_scenes(options, {}, ".");
   REQUIRE(alone.size() == 1);
   CHECK(alone[0].name == "alone");
   CHECK(alone[0].steps == 3);
 
-  const std::vector<cl::Scene> both = cl::load_scenes(options, {scene_file("first", 5), scene_file("second", 6)}, ".");
+  const std::vector<cl::Scene> both =
+      cl::load_scenes(options, {scene_file(scratch, "first", 5), scene_file(scratch, "second", 6)}, ".");
   REQUIRE(both.size() == 2);
   CHECK(both[0].name == "first");
   CHECK(both[1].name == "second");
   CHECK(both[1].steps == 3);
 
-  CHECK_THROWS_AS(cl::load_scenes(options, {"driver_kit_no_such_scene.json"}, "."), cl::InputError);
+  CHECK_THROWS_AS(cl::load_scenes(options, {scratch.file("no_such_scene.json")}, "."), cl::InputError);
   // An unknown name is the fault of the flag that gave it.
   CHECK_THROWS_WITH(cl::load_scenes(options, {"driver-kit-no-such-name"}, "."),
                     Catch::Matchers::StartsWith("--sweep-scenes: no scene named 'driver-kit-no-such-name'"));
@@ -107,8 +110,9 @@ TEST_CASE("cell_if is the number where it is known and an empty cell where it is
 }
 
 TEST_CASE("require_finite_springs names the first hard spring and lets finite ones by", "[common][driver]") {
+  const cl::test::ScratchDir scratch("driver_kit_hard");
   cl::CommonOptions options;
-  options.scene = scene_file("hard", 1);  // its spring has the default stiffness, inf
+  options.scene = scene_file(scratch, "hard", 1);  // its spring has the default stiffness, inf
   cl::Scene scene = cl::load_scenes(options, {}, ".").front();
   CHECK_THROWS_WITH(cl::require_finite_springs(scene, "why"),
                     scene.source + ": springs[0].stiffness: inf is a hard constraint; why");

@@ -12,6 +12,7 @@
 #include "common/frame_loop.h"
 #include "common/health.h"
 #include "common/output.h"
+#include "tests/support/scratch.h"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
@@ -45,12 +46,10 @@ struct Kicked {
   }
 };
 
-// Output asking for the history in frame_loop_test_out/FILE.
-cl::FrameOutput history_in(const std::string& file) {
-  const std::string dir = "frame_loop_test_out";
-  cl::ensure_directory(dir);
+// Output asking for the history in `scratch`/FILE.
+cl::FrameOutput history_in(const cl::test::ScratchDir& scratch, const std::string& file) {
   cl::FrameOutput output;
-  output.csv_path = cl::join_path(dir, file);
+  output.csv_path = scratch.file(file);
   return output;
 }
 
@@ -154,7 +153,8 @@ TEST_CASE("a step that could not be taken stops the run, is not counted, and kee
   Kicked run;
   run.kick = 0.0;
   const cl::FramePlan plan = cl::frame_plan(10, 0.1, 0.0);
-  cl::FrameOutput output = history_in("per_frame.csv");
+  const cl::test::ScratchDir scratch("frame_loop_failed_step");
+  cl::FrameOutput output = history_in(scratch, "per_frame.csv");
   output.columns = {"speed"};
   const cl::FrameLoopResult result = cl::run_frame_loop(
       run.state,
@@ -176,7 +176,8 @@ TEST_CASE("a step's own problem is prefixed in the history and the loop's clock 
   Kicked run;
   run.kick = 0.0;
   const cl::FramePlan plan = cl::frame_plan(5, 1.0, 0.0);
-  cl::FrameOutput output = history_in("per_step.csv");
+  const cl::test::ScratchDir scratch("frame_loop_step_problem");
+  cl::FrameOutput output = history_in(scratch, "per_step.csv");
   output.index_column = "step";
   output.problem_prefix = "unstable: ";
   const cl::FrameLoopResult result = cl::run_frame_loop(

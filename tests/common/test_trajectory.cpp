@@ -17,6 +17,7 @@
 #include "common/frame_loop.h"
 #include "common/output.h"
 #include "common/trajectory.h"
+#include "tests/support/scratch.h"
 
 using Catch::Matchers::Contains;
 
@@ -74,8 +75,8 @@ double decoded_strain(const nlohmann::json& header, const std::vector<std::uint8
 
 TEST_CASE("a trajectory reads back to the stated quantisation, with its topology and identity",
           "[common][trajectory]") {
-  const std::string dir = "trajectory_test_out/round_trip";
-  cl::ensure_directory(dir);
+  const cl::test::ScratchDir scratch("trajectory_round_trip");
+  const std::string dir = scratch.path();
   const cl::Scene scene = small_scene();
   cl::TrajectoryWriter writer(dir, 1, scene, {"lab99_test", "test-method", "total energy", "s"});
   std::vector<Eigen::Matrix3Xd> written;
@@ -125,9 +126,10 @@ TEST_CASE("a trajectory reads back to the stated quantisation, with its topology
 
 TEST_CASE("a scene's colliders travel in the header, and a scene without writes no colliders key",
           "[common][trajectory]") {
+  const cl::test::ScratchDir scratch("trajectory_colliders");
   cl::Scene scene = small_scene();
   const auto header_of = [&] {
-    cl::TrajectoryWriter writer("trajectory_test_out/colliders", 1, scene, {"lab99_test", "m", "total energy", "s"});
+    cl::TrajectoryWriter writer(scratch.path(), 1, scene, {"lab99_test", "m", "total energy", "s"});
     writer.add(0, 0.0, scene.particles.x, 0.0, "ok");
     return nlohmann::json::parse(writer.header_text());
   };
@@ -176,8 +178,8 @@ TEST_CASE("the frame loop keeps every N-th frame, the last planned one and the f
   output.trajectory_every = 3;
 
   SECTION("a run that finishes: 0, 3, 6, 9 and the last, 10") {
-    output.trajectory_dir = "trajectory_test_out/every_3";
-    cl::ensure_directory(output.trajectory_dir);
+    const cl::test::ScratchDir scratch("trajectory_every_3");
+    output.trajectory_dir = scratch.path();
     const cl::FrameLoopResult result = cl::run_frame_loop(state, step, measure, cl::frame_plan(10, 0.5, 0.0), output);
     CHECK(result.trajectory_frames == 5);
     const nlohmann::json header = read_json(output.trajectory_dir + "/trajectory.json");
@@ -190,8 +192,8 @@ TEST_CASE("the frame loop keeps every N-th frame, the last planned one and the f
   }
   SECTION("a run that stops at frame 4: 0, 3 and 4, with its status") {
     stop_at = 4;
-    output.trajectory_dir = "trajectory_test_out/stopped";
-    cl::ensure_directory(output.trajectory_dir);
+    const cl::test::ScratchDir scratch("trajectory_stopped");
+    output.trajectory_dir = scratch.path();
     cl::run_frame_loop(state, step, measure, cl::frame_plan(10, 0.5, 0.0), output);
     const nlohmann::json header = read_json(output.trajectory_dir + "/trajectory.json");
     REQUIRE(header["frame_count"] == 3);
@@ -202,8 +204,8 @@ TEST_CASE("the frame loop keeps every N-th frame, the last planned one and the f
 
 TEST_CASE("a frame with a non-finite position is not kept: it is the header's stopped record",
           "[common][trajectory]") {
-  const std::string dir = "trajectory_test_out/non_finite";
-  cl::ensure_directory(dir);
+  const cl::test::ScratchDir scratch("trajectory_non_finite");
+  const std::string dir = scratch.path();
   const cl::Scene scene = small_scene();
   cl::TrajectoryWriter writer(dir, 1, scene, {"lab99_test", "m"});
   writer.add(0, 0.0, scene.particles.x, std::numeric_limits<double>::quiet_NaN(), "ok");
@@ -251,6 +253,7 @@ TEST_CASE("a trajectory (--frames) needs --out, checked when the scene is loaded
   options.scene = "curtain-8";
   options.frames = 2;
   CHECK_THROWS_WITH(cl::load_scene_for(options, cl::lab_scene_dir("lab04_pbd")), Contains("--frames: needs --out"));
-  options.out = "trajectory_test_out/unused";
+  const cl::test::ScratchDir scratch("trajectory_unused");
+  options.out = scratch.file("unused");
   CHECK_NOTHROW(cl::load_scene_for(options, cl::lab_scene_dir("lab04_pbd")));
 }
