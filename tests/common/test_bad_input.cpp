@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "tests/support/scratch.h"
+
 using Catch::Matchers::Contains;
 using Catch::Matchers::StartsWith;
 
@@ -91,8 +93,8 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
   };
   int index = 0;
   for (const Rule& rule : rules) {
-    const fs::path dir = fs::temp_directory_path() / ("cl_bad_input_" + std::to_string(index++));
-    fs::remove_all(dir);
+    const cl::test::ScratchDir scratch("bad_input_" + std::to_string(index++));
+    const fs::path dir = scratch.path();
     CAPTURE(rule.what, rule.text);
     const RunResult result = run_scene(rule.text, dir);
     CAPTURE(result.stderr_text);
@@ -101,14 +103,12 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
     CHECK_THAT(result.stderr_text, Contains(rule.field));
     CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
     CHECK_FALSE(fs::exists(dir / "out"));
-    fs::remove_all(dir);
   }
 }
 
 TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
-  const fs::path dir = fs::temp_directory_path() / "cl_bad_cli";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const cl::test::ScratchDir scratch("bad_cli");
+  const fs::path dir = scratch.path();
   for (const char* arguments : {"--no-such-flag", "--scene no-such-scene", "--scene /no/such/file.json",
                                 "--scene"}) {
     CAPTURE(arguments);
@@ -118,5 +118,4 @@ TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
     CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
     CHECK_THAT(result.stderr_text, StartsWith("lab01_single_spring"));
   }
-  fs::remove_all(dir);
 }

@@ -18,6 +18,7 @@
 #include "common/output.h"
 #include "common/scene.h"
 #include "common/summary.h"
+#include "tests/support/scratch.h"
 
 using Catch::Matchers::WithinRel;
 
@@ -170,8 +171,8 @@ TEST_CASE("add_divergence writes diverged and, only when it did, where and why",
 }
 
 TEST_CASE("an OBJ frame is named by its zero-padded number and says what it is", "[common]") {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "cl_test_obj_frame";
-  std::filesystem::remove_all(dir);
+  const cl::test::ScratchDir scratch("obj_frame");
+  const std::filesystem::path dir = scratch.path();
   const cl::Scene scene = two_particles();
   cl::write_frame_obj(dir.string(), "labXX", scene, scene.particles.x, 42, 0.5);
   std::ifstream file(dir / "frame_000042.obj");
@@ -186,7 +187,6 @@ TEST_CASE("an OBJ frame is named by its zero-padded number and says what it is",
   }
   CHECK(vertices == 2);
   CHECK(lines == 1);  // no triangles: the spring as a line
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("add_stop_outcome writes diverged and the failure, and only for a stopped run its outcome and step",

@@ -10,6 +10,7 @@
 #include "common/obj.h"
 #include "common/output.h"
 #include "common/summary.h"
+#include "tests/support/scratch.h"
 
 namespace {
 std::string read(const std::filesystem::path& path) {
@@ -19,11 +20,6 @@ std::string read(const std::filesystem::path& path) {
   return text.str();
 }
 
-std::filesystem::path fresh_dir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("cl_test_" + name);
-  std::filesystem::remove_all(dir);
-  return dir;
-}
 }  // namespace
 
 TEST_CASE("doubles are written so that they read back exactly", "[common][output]") {
@@ -34,14 +30,14 @@ TEST_CASE("doubles are written so that they read back exactly", "[common][output
 }
 
 TEST_CASE("a CSV table is written whole into a new directory", "[common][output]") {
-  const std::filesystem::path dir = fresh_dir("csv");
+  const cl::test::ScratchDir scratch("output_csv");
+  const std::filesystem::path dir = scratch.path();
   cl::CsvTable table({"a", "b", "c"});
   table.add_row({0.1, 2LL, std::string("x")});
   CHECK_THROWS_AS(table.add_row({1.0}), std::invalid_argument);
   table.write((dir / "sub" / "t.csv").string());
   CHECK(read(dir / "sub" / "t.csv") == "a,b,c\n0.10000000000000001,2,x\n");
   CHECK_FALSE(std::filesystem::exists(dir / "sub" / "t.csv.part"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("CSV text with commas, quotes or line breaks is quoted as RFC 4180 says", "[common][output]") {
@@ -54,7 +50,8 @@ TEST_CASE("CSV text with commas, quotes or line breaks is quoted as RFC 4180 say
 }
 
 TEST_CASE("the run summary has the contract's keys and exact positions", "[common][output]") {
-  const std::filesystem::path dir = fresh_dir("summary");
+  const cl::test::ScratchDir scratch("output_summary");
+  const std::filesystem::path dir = scratch.path();
   cl::RunSummary summary;
   summary.lab = "lab01_single_spring";
   summary.method = "single-pass";
@@ -72,7 +69,6 @@ TEST_CASE("the run summary has the contract's keys and exact positions", "[commo
   CHECK(parsed.contains("rms_strain_error"));
   CHECK_FALSE(parsed.contains("velocities"));
   CHECK_FALSE(parsed.contains("dt"));
-  std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("OBJ text: vertices, then faces or, without triangles, lines", "[common][output]") {

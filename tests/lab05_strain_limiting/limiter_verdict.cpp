@@ -39,9 +39,7 @@ cl::Scene stiff_chain() {
             ", \"rest\": 0.1, \"stiffness\": 1e6}";
   }
   json += "]}";
-  const std::string path = "lab05_limiter_verdict_stiff_chain.json";
-  cl::write_file_atomic(path, json);
-  return cl::load_scene(path);
+  return cl::parse_scene(json, "stiff-chain (limiter_verdict.cpp)");
 }
 
 cl::lab05::RunResult run(const cl::Scene& scene, Limit limit, int iterations, double& max_strain,
