@@ -50,9 +50,22 @@ int run_live_scene(const char* lab_name, const CommonOptions& options, const Lab
   std::optional<Solver> solver;
   std::optional<lab06::Solver> lab06_solver;
   const bool constrained = options.method == "constrained-newton";
+  // What the solver was built for: the masses (pins and held particles), Δt
+  // and k. K alone changes none of it, so turning K keeps the solver, its
+  // factor's analysis and a hard set's warm multipliers.
+  Eigen::VectorXd built_inv_mass;
+  double built_dt = 0.0, built_k = 0.0;
   run.changed = [&](const Knobs& knobs) {
+    const double k = finite ? knobs[2] : 0.0;
+    if (built_inv_mass.size() != 0 && built_inv_mass == scene.particles.inv_mass && built_dt == knobs[1] &&
+        built_k == k) {
+      return;
+    }
+    built_inv_mass = scene.particles.inv_mass;
+    built_dt = knobs[1];
+    built_k = k;
     if (finite) {
-      for (Spring& spring : springs) spring.stiffness = knobs[2];
+      for (Spring& spring : springs) spring.stiffness = k;
     }
     if (constrained) {
       solver.emplace(scene.particles.inv_mass, springs, knobs[1]);
