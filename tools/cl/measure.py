@@ -85,3 +85,27 @@ def check_measurements(checks, out):
             continue
         checks.record(code == 0, f"{program} --quick: {lines[-1] if lines else 'no output'}",
                       [] if code == 0 else lines[-20:])
+    check_micro(checks)
+
+
+def check_micro(checks):
+    """CI: each Google Benchmark program runs every benchmark for about 1 ms
+    and exits 0 (built and runnable; the numbers are not judged: timing lives
+    in ./course bench --micro, never in a test)."""
+    targets = micro_targets()
+    if not targets:
+        return
+    with checks.timed("measurements: Google Benchmark programs, one short pass"):
+        try:
+            build_targets(targets)
+        except (CourseError, BuildFailure) as error:
+            checks.record(False, f"Google Benchmark programs: {error}")
+            return
+        for name in targets:
+            done = subprocess.run([str(executable(name)), "--benchmark_min_time=0.001"], cwd=ROOT,
+                                  capture_output=True, text=True, check=False)
+            runs = sum(1 for line in done.stdout.splitlines() if line.startswith("BM_"))
+            ok = done.returncode == 0 and runs > 0
+            checks.record(ok, f"{name}: {runs} benchmarks ran, about 1 ms each"
+                          + ("" if ok else f" (exit {done.returncode})"),
+                          [] if ok else (done.stdout + done.stderr).splitlines()[-20:])
