@@ -4,8 +4,8 @@ step for every method and iteration count, the Pareto front highlighted. Top
 row: max strain error; middle row: distance to the converged reference step,
 relative to the step's displacement; bottom row (when trade.csv has it): the
 same for the hard step, the hard family's own target. Where a scene's step has
-two minimisers (trade_scenes.csv's reference_spread), the distances below
-their spread are shaded: unresolved. Reads OUTDIR/bench/trade.csv and
+two minimisers (trade_scenes.csv's reference_spread and hard_spread), the
+distances below their spread are shaded: unresolved. Reads OUTDIR/bench/trade.csv and
 trade_scenes.csv, writes OUTDIR/bench/pareto.png."""
 import math
 from pathlib import Path
@@ -36,12 +36,13 @@ def main(out_dir):
     scene_table = bench / "trade_scenes.csv"
     if figures.up_to_date(target, [table] + ([scene_table] if scene_table.exists() else [])):
         return 0
-    spread = {}  # scene -> the two routes' spread, where it is above round-off
+    spread = {}  # (measure, scene) -> the two routes' spread, where it is above round-off
     if scene_table.exists():
         for r in figures.rows(scene_table):
-            value = float(r.get("reference_spread") or "nan")
-            if math.isfinite(value) and value > 1e-6:
-                spread[r["scene"]] = value
+            for key, column in (("relative_distance", "reference_spread"), ("relative_distance_hard", "hard_spread")):
+                value = float(r.get(column) or "nan")
+                if math.isfinite(value) and value > 1e-6:
+                    spread[(key, r["scene"])] = value
     rows = [r for r in figures.rows(table) if not r["problem"]]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
@@ -73,11 +74,12 @@ def main(out_dir):
                        linewidths=1.2, zorder=5)
             for level in (1e-2, 1e-3):
                 ax.axhline(level, color="gray", linestyle=":", linewidth=0.8)
-            if key == "relative_distance" and scene in spread:
+            if (key, scene) in spread:
+                level = spread[(key, scene)]
                 low, high = ax.get_ylim()  # the span must not stretch the axis down to round-off
-                ax.axhspan(low, spread[scene], color="gray", alpha=0.15, zorder=0,
+                ax.axhspan(low, level, color="gray", alpha=0.15, zorder=0,
                            label="unresolved: the step has two minimisers this far apart")
-                ax.set_ylim(low, max(high, 2.0 * spread[scene]))
+                ax.set_ylim(low, max(high, 2.0 * level))
             ax.set_xlabel("wall time per step (s)")
             if column == 0:
                 ax.set_ylabel(label)
