@@ -345,6 +345,17 @@ void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
       }
     }
   }
+  // A width or height so small for nx, ny that a cell's area underflows to 0
+  // in double precision (an overflow is check_finite_geometry's): the
+  // smaller spacing is named.
+  const bool areas_ok = std::all_of(scene.triangles.begin(), scene.triangles.end(),
+                                    [](const Triangle& triangle) { return triangle.rest_area != 0.0; });
+  if (!areas_ok) {
+    const bool across = width / (nx - 1) <= height / (ny - 1);
+    reader.fail(across ? "cloth.width" : "cloth.height",
+                std::string("too small for ") + (across ? "nx = " + std::to_string(nx) : "ny = " + std::to_string(ny)) +
+                    ": its triangles' rest areas underflow to 0 in double precision");
+  }
 }
 
 void generate_chain(const Reader& reader, const json& chain, Scene& scene) {

@@ -89,6 +89,7 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
       {"length overflows", R"({"particles": [{"x": [0,0,0]}, {"x": [1e200,0,0]}], "springs": [{"i": 0, "j": 1}]})",
        "springs[0]"},
       {"cloth too wide", R"({"cloth": {"nx": 5000}})", "cloth.nx"},
+      {"cloth cell area underflows", R"({"cloth": {"nx": 4, "width": 1e-200}})", "cloth.width"},
       {"cloth unknown pin", R"({"cloth": {"nx": 4, "pin": ["centre"]}})", "cloth.pin[0]"},
   };
   int index = 0;
