@@ -138,7 +138,7 @@ struct Run {
   bool on_front = false;
 };
 
-// The second route to the k step against the reference (reference_spread, below).
+// A second route's end against its step (second_route, below).
 struct Spread {
   double relative = std::numeric_limits<double>::quiet_NaN();
   int iterations = 0;
@@ -375,9 +375,9 @@ Reference reference_step(const cl::Scene& scene, const cl::Particles& start) {
 // step, bench/README.md, run I), they can end at different ones; and at
 // k = 1e9 N/m a gradient at round-off still leaves the soft directions loose
 // (128²'s hard routes end 1.3e-4 apart). Either way no method can be said to
-// be nearer the step than the spread: the targets below it are unresolved. NaN when the second route does not converge
-// (|∇g| above `tolerance`, the step's own: 1e-8 N for the k step, 1e-6 N
-// for the hard step at k = 1e9 N/m).
+// be nearer the step than the spread: the targets below it are unresolved.
+// NaN when the second route does not converge (|∇g| above `tolerance`, the
+// step's own: 1e-8 N for the k step, 1e-6 N for the hard step at k = 1e9 N/m).
 Spread second_route(const cl::lab06::Problem& problem, const cl::Particles& start, const Eigen::Matrix3Xd& y,
                     const Eigen::Matrix3Xd& step, double tolerance) {
   const cl::Timer timer;
@@ -427,6 +427,13 @@ void print_spread(const std::string& scene, const Spread& spread, const char* wh
 // with k). Otherwise the scene has no hard step (relative_distance_hard NaN).
 constexpr double kHardStiffness = 1e9;  // N/m
 
+// The scene's springs at kHardStiffness: the hard step's.
+std::vector<cl::Spring> hard_springs(const cl::Scene& scene) {
+  std::vector<cl::Spring> springs = scene.springs;
+  for (cl::Spring& spring : springs) spring.stiffness = kHardStiffness;
+  return springs;
+}
+
 struct HardStep {
   Eigen::Matrix3Xd x;  // empty when it failed
   int iterations = 0;         // lab 13's
@@ -443,8 +450,7 @@ HardStep hard_step(const cl::Scene& scene, const cl::Particles& start, const Ref
     hard.problem = "no multipliers from the k step";
     return hard;
   }
-  std::vector<cl::Spring> springs = scene.springs;
-  for (cl::Spring& spring : springs) spring.stiffness = kHardStiffness;
+  const std::vector<cl::Spring> springs = hard_springs(scene);
   const cl::lab13::Solver solver(scene.particles.inv_mass, springs, scene.dt);
   cl::lab13::Settings settings;
   settings.gravity = scene.gravity;
@@ -630,10 +636,8 @@ int run(const Options& options) {
     std::fflush(stdout);
     if (info.hard_displacement > 0.0) {
       progress.show(where + " second route to the hard step");
-      std::vector<cl::Spring> hard_springs = scene.springs;
-      for (cl::Spring& spring : hard_springs) spring.stiffness = kHardStiffness;
-      info.hard_spread = second_route(cl::lab06::make_problem(scene.particles.inv_mass, hard_springs, scene.dt), start,
-                                      y, hard.x, 1e-6);
+      info.hard_spread = second_route(cl::lab06::make_problem(scene.particles.inv_mass, hard_springs(scene), scene.dt),
+                                      start, y, hard.x, 1e-6);
       progress.clear();
       print_spread(scene.name, info.hard_spread, "the hard step");
     }

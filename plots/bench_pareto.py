@@ -5,8 +5,8 @@ row: max strain error; middle row: distance to the converged reference step,
 relative to the step's displacement; bottom row (when trade.csv has it): the
 same for the hard step, the hard family's own target. Where a scene's step has
 two minimisers (trade_scenes.csv's reference_spread and hard_spread), the
-distances below their spread are shaded: unresolved. Reads OUTDIR/bench/trade.csv and
-trade_scenes.csv, writes OUTDIR/bench/pareto.png."""
+distances below their spread are shaded: unresolved. Reads
+OUTDIR/bench/trade.csv and trade_scenes.csv, writes OUTDIR/bench/pareto.png."""
 import math
 from pathlib import Path
 
