@@ -385,7 +385,7 @@ int run(const Options& options) {
   }
   const int steps = options.steps > 0 ? options.steps : (options.quick ? 8 : 120);
   const int long_steps = options.long_steps > 0 ? options.long_steps : (options.quick ? 2 : 12);
-  cl::ensure_directory(options.out);
+  cl::start_run(options.out);
 #ifdef _OPENMP
   omp_set_num_threads(options.threads);
   cl::set_blas_threads(options.threads);  // CHOLMOD's BLAS too: serial methods, timed side by side

@@ -551,7 +551,7 @@ int run(const Options& options) {
   const int warmup = options.warmup > 0 ? options.warmup : (options.quick ? 5 : 10);
   const double cap = options.step_cap > 0.0 ? options.step_cap : (options.quick ? 0.05 : 0.3);
   for (const std::string& name : scenes) make_scene(name, options.stiffness);  // bad names fail before any work
-  cl::ensure_directory(options.out);
+  cl::start_run(options.out);
 #ifdef _OPENMP
   omp_set_num_threads(options.threads);
   cl::set_blas_threads(options.threads);  // CHOLMOD's BLAS too: serial methods, timed side by side

@@ -10,11 +10,25 @@
 #include <CLI/CLI.hpp>
 
 #include "common/not_implemented.h"
+#include "common/output.h"
 #include "common/trajectory.h"
 
 namespace cl {
 
 namespace {
+// The scenes this run loaded, for --check's line (in the order loaded, each once).
+std::vector<std::string> loaded_scenes;
+
+void note_scene(const Scene& scene) {
+  std::ostringstream text;
+  text << describe(scene);
+  if (scene.steps > 0 && scene.dt > 0.0) text << " dt " << scene.dt << " s, " << scene.steps << " steps";
+  if (!scene.colliders.empty()) text << ", " << scene.colliders.size() << " colliders";
+  if (std::find(loaded_scenes.begin(), loaded_scenes.end(), text.str()) == loaded_scenes.end()) {
+    loaded_scenes.push_back(text.str());
+  }
+}
+
 // Reads a whole argument as a finite double; false for anything else.
 bool parse_finite(const std::string& text, double& value) {
   try {
@@ -171,6 +185,31 @@ Option& Option::only_for_methods(std::vector<std::string> methods) {
   return *this;
 }
 
+Option& Option::only_for_modes(std::vector<std::string> modes) {
+  if (line_ == nullptr) throw std::logic_error("Option::only_for_modes: an option of a CommandLine only");
+  line_->mode_flags_.push_back({option_, std::move(modes)});
+  return *this;
+}
+
+void CommandLine::add_mode(const std::string& name) { modes_.push_back(app_->get_option(name)); }
+
+void CommandLine::modes(const std::vector<std::pair<std::string, std::vector<std::string>>>& modes,
+                        const std::vector<std::string>& run_only) {
+  std::vector<std::pair<std::string, std::vector<std::string>>> readers;  // option, the modes that read it
+  auto add = [&](const std::string& option, const std::string& mode) {
+    for (auto& entry : readers) {
+      if (entry.first == option) return entry.second.push_back(mode);
+    }
+    readers.push_back({option, {mode}});
+  };
+  for (const auto& [mode, options] : modes) {
+    add_mode(mode);
+    for (const std::string& option : options) add(option, mode);
+  }
+  for (const std::string& option : run_only) add(option, "run");
+  for (const auto& [option, readers_of] : readers) get_option(option).only_for_modes(readers_of);
+}
+
 CommandLine::CommandLine(const std::string& description, const std::string& program_name)
     : app_(std::make_unique<CLI::App>(description, program_name)) {}
 
@@ -226,6 +265,24 @@ void CommandLine::refuse_unused_flags() const {
     throw InputError(flag.option->get_name() + ": --method " + *method_ + " does not use it (only " + users +
                      (flag.methods.size() == 1 ? " does)" : " do)"));
   }
+  std::vector<std::string> active;
+  for (const CLI::Option* mode : modes_) {
+    if (mode->count() > 0) active.push_back(mode->get_name());
+  }
+  const std::string current = active.empty() ? std::string("a run") : active.front();
+  if (active.empty()) active.push_back("run");
+  for (const MethodFlag& flag : mode_flags_) {
+    if (flag.option->count() == 0) continue;
+    bool read = false;
+    for (const std::string& mode : active) {
+      read = read || std::find(flag.methods.begin(), flag.methods.end(), mode) != flag.methods.end();
+    }
+    if (read) continue;
+    std::string readers;
+    for (const std::string& mode : flag.methods) readers += (readers.empty() ? "" : ", ") + (mode == "run" ? "a run" : mode);
+    throw InputError(flag.option->get_name() + ": " + current + " does not read it (only " + readers +
+                     (flag.methods.size() == 1 ? " does)" : " do)"));
+  }
 }
 
 void add_common_options(CommandLine& line, CommonOptions& options, unsigned flags) {
@@ -244,7 +301,24 @@ Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_
     if (options.out.empty()) throw InputError("--frames: needs --out DIR (the trajectory goes to OUT/trajectory.*)");
     check_trajectory_size(scene, options.frames_are_sweeps ? options.iterations : scene.steps, options.frames);
   }
+  note_scene(scene);
   return scene;
+}
+
+void start_run(const CommonOptions& options) {
+  if (check_mode()) {
+    std::string line;
+    if (!options.method.empty()) line += ", --method " + options.method;
+    if (!options.out.empty()) line += ", writes " + options.out + "/";
+    if (!options.summary.empty()) line += ", summary " + options.summary;
+    throw CheckStop{line};
+  }
+  ensure_directory(options.out);
+}
+
+void start_run(const std::string& out_dir) {
+  if (check_mode()) throw CheckStop{out_dir.empty() ? std::string() : ", writes " + out_dir + "/"};
+  ensure_directory(out_dir);
 }
 
 namespace {
@@ -269,14 +343,48 @@ int noting(int code, const std::string& program, const char* student_earlier_lab
 }
 }  // namespace
 
+namespace {
+// "unknown option --rho (options: --scene, --method, ...)" for CLI11's "The
+// following arguments were not expected: 0.5 --rho": the first word that
+// looks like an option names it; a stray value is named as one.
+std::string unknown_option_line(const CLI::App& app, int argc, char** argv) {
+  std::string options;
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string name = option->get_name();
+    if (name.rfind("--", 0) == 0 && name != "--help") options += (options.empty() ? "" : ", ") + name;
+  }
+  for (int i = 1; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word.rfind("--", 0) != 0) continue;
+    const std::string name = word.substr(0, word.find('='));
+    if (app.get_option_no_throw(name) == nullptr) return "unknown option " + name + " (options: " + options + ")";
+  }
+  for (int i = 1; i < argc; ++i) {
+    const std::string word = argv[i];
+    if (word.rfind("-", 0) == 0) continue;
+    bool value = i > 1 && std::string(argv[i - 1]).rfind("--", 0) == 0;
+    if (!value) return "unexpected argument '" + word + "' (options: " + options + ")";
+  }
+  return "unexpected arguments (options: " + options + ")";
+}
+}  // namespace
+
 int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
              const char* student_earlier_labs) {
   const std::string program = app.get_name();
   std::vector<const char*> words(argv, argv + argc);
   if (!words.empty()) words[0] = program.c_str();
   set_command_line(argc, words.data());
+  bool check = false;
+  if (app.get_option_no_throw("--check") == nullptr) {
+    app.add_flag("--check", check,
+                 "check the flags and the scene as a run would, print what would run, and stop (nothing written)");
+  }
   try {
     app.parse(argc, argv);
+  } catch (const CLI::ExtrasError& error) {
+    std::cerr << program << ": " << unknown_option_line(app, argc, argv) << "\n";
+    return 2;
   } catch (const CLI::CallForHelp&) {
     std::cout << app.help();
     return 0;
@@ -287,8 +395,15 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
     std::cerr << program << ": " << error.what() << " (see --help)\n";
     return 2;
   }
+  set_check_mode(check);
   try {
     return noting(body(), program, student_earlier_labs);
+  } catch (const CheckStop& stop) {
+    std::string scenes;
+    for (const std::string& scene : loaded_scenes) scenes += (scenes.empty() ? "" : "; ") + scene;
+    std::cout << program << ": check: ok, would run " << (scenes.empty() ? std::string("(no scene)") : scenes)
+              << stop.detail << "\n";
+    return 0;
   } catch (const InputError& error) {
     std::cerr << program << ": " << error.what() << "\n";
     return 2;

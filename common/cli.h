@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/scene.h"
@@ -95,6 +96,13 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags);
 Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_dir,
                      const std::string& flag = "--scene");
 
+// Where a run starts, once all of its input is checked: under --check the
+// run stops here (run_main prints what would run: the scenes loaded, the
+// method, the files it would write; exit 0, nothing written); otherwise it
+// makes --out's folder, so that a refusal before it leaves nothing behind.
+void start_run(const CommonOptions& options);
+void start_run(const std::string& out_dir);  // a driver without CommonOptions' --out (lab 01's --sweep)
+
 
 // One option of a CommandLine, for chaining its checks and help, in CLI11's
 // terms: app.add_option("--seed", seed, "...").range(0, 1000).capture_default_str().
@@ -116,6 +124,11 @@ class Option {
   // refused before the run (exit 2, one line: "--rho: --method pd does not
   // use it (only pd-chebyshev, jacobi-chebyshev do)"), not silently ignored.
   Option& only_for_methods(std::vector<std::string> methods);
+  // Only these modes read the option: a mode is a flag or list option declared
+  // by CommandLine::add_mode (--convergence, --sweep-iterations), and "run" is
+  // the program without any. Given in another mode it is refused before the
+  // run ("--steps: --convergence does not read it (only a run does)").
+  Option& only_for_modes(std::vector<std::string> modes);
 
  private:
   CLI::Option* option_;
@@ -144,8 +157,19 @@ class CommandLine {
 
   CLI::App& app() { return *app_; }
 
+  // Declares an option (added already) as a mode of the program, for
+  // Option::only_for_modes: the mode is on when the option is given.
+  void add_mode(const std::string& name);
+
+  // The program's modes in one call: each mode option (added already) with the
+  // options only it reads, and the options only a plain run reads; the rest
+  // are read in every mode. Short for add_mode and only_for_modes.
+  void modes(const std::vector<std::pair<std::string, std::vector<std::string>>>& modes,
+             const std::vector<std::string>& run_only);
+
   // Throws InputError for the first option given with a --method that its
-  // only_for_methods list leaves out; run_main calls it after parsing.
+  // only_for_methods list leaves out, or in a mode that its only_for_modes
+  // list leaves out; run_main calls it after parsing.
   void refuse_unused_flags() const;
 
  private:
@@ -157,6 +181,8 @@ class CommandLine {
   };
   std::unique_ptr<CLI::App> app_;
   std::vector<MethodFlag> method_flags_;
+  std::vector<MethodFlag> mode_flags_;     // an option and the modes that read it
+  std::vector<CLI::Option*> modes_;        // the options that select a mode
   const std::string* method_ = nullptr;  // the --method value (add_common_options with kFlagMethod)
 };
 
@@ -169,6 +195,11 @@ void add_common_options(CommandLine& line, CommonOptions& options, unsigned flag
 // anything else -> 1. `body` returns the exit code for a run that finished.
 // With a CommandLine, the options given to a method that does not use them are
 // refused first (refuse_unused_flags), before `body` writes anything.
+// Every program takes --check (docs/DESIGN.md §3): the body runs until
+// start_run (or any first write or step), which under --check stops it; the
+// one line "PROGRAM: check: would run ..." goes to stdout, exit 0.
+// An unknown option is refused as "unknown option --rho" with the program's
+// options listed.
 // A run that gets past its input (exit 0, 1 or 3) and links the student's code
 // of earlier labs (`student_earlier_labs`) says so in one more stderr line; a
 // refusal (exit 2) stays one line.

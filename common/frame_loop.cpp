@@ -7,6 +7,7 @@
 
 #include "common/health.h"
 #include "common/obj.h"
+#include "common/output.h"
 #include "common/timer.h"
 #include "common/trajectory.h"
 #include "common/window_means.h"
@@ -81,8 +82,27 @@ FramePlan frame_plan(int frames, double dt, double energy_scale) {
   return plan;
 }
 
+namespace {
+// A function's own argument check that fires inside a step (a student
+// function's std::invalid_argument) is that step's failure, reported with the
+// step and its likely cause like any other problem, not a bare "invalid
+// argument" after the run's files were started (docs/DESIGN.md §3).
+StepVerdict guarded_step(const StepFunction& step, int frame) {
+  try {
+    return step(frame);
+  } catch (const std::invalid_argument& refusal) {
+    StepVerdict verdict;
+    verdict.taken = false;
+    verdict.problem = "step " + std::to_string(frame) + " could not be taken: a function refused its input (" +
+                      refusal.what() + "); the run's state left that function's range, or an earlier result was wrong";
+    return verdict;
+  }
+}
+}  // namespace
+
 FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const MeasureFunction& measure,
                                const FramePlan& plan, const FrameOutput& output, const FrameHook& on_frame) {
+  stop_if_checking();  // --check: a run that got here without start_run stops before its first step
   if (plan.frames < 0 || plan.window_frames < 0 || !(plan.settle_tolerance >= 0.0)) {
     throw std::invalid_argument("run_frame_loop: needs frames >= 0, window_frames >= 0, settle_tolerance >= 0");
   }
@@ -115,7 +135,7 @@ FrameLoopResult run_frame_loop(Particles& state, const StepFunction& step, const
   std::vector<WindowMeans> windows;
   for (int f = 1; f <= plan.frames; ++f) {
     const Timer timer;
-    const StepVerdict verdict = step(f);
+    const StepVerdict verdict = guarded_step(step, f);
     const double seconds = verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds();
     result.seconds += seconds;
     measured = measure(f, seconds);

@@ -17,6 +17,7 @@
 #include "common/health.h"
 #include "common/live_server.h"
 #include "common/metrics.h"
+#include "common/output.h"
 #include "common/summary.h"
 #include "common/timer.h"
 #include "common/trajectory.h"
@@ -73,6 +74,7 @@ std::string live_page() {
 }
 
 int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const std::string& summary_path) {
+  stop_if_checking();  // --check: no server is started
   Particles& state = scene.particles;
   const Particles start = state;
   const Eigen::Index n = state.size();

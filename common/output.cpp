@@ -10,7 +10,19 @@ namespace cl {
 
 namespace fs = std::filesystem;
 
+namespace {
+bool checking = false;
+}  // namespace
+
+void set_check_mode(bool on) { checking = on; }
+bool check_mode() { return checking; }
+
+void stop_if_checking() {
+  if (checking) throw CheckStop{};
+}
+
 void ensure_directory(const std::string& dir) {
+  stop_if_checking();
   if (dir.empty()) return;
   std::error_code error;
   fs::create_directories(dir, error);
@@ -20,6 +32,7 @@ void ensure_directory(const std::string& dir) {
 }
 
 void write_file_atomic(const std::string& path, const std::string& content) {
+  stop_if_checking();
   const fs::path target(path);
   if (target.has_parent_path()) ensure_directory(target.parent_path().string());
   const std::string temporary = path + ".part";

@@ -10,11 +10,14 @@ import sys
 from cl.autograder import cmd_autograder
 from cl.base import CourseError
 from cl.checks import cmd_test
+from cl.claims import cmd_claims
 from cl.demo import cmd_demo, cmd_run
 from cl.fuzz import cmd_fuzz
 from cl.grading import cmd_grade
+from cl.handouts import cmd_handouts
 from cl.live import cmd_live
 from cl.measure import cmd_bench, cmd_extremes
+from cl.mistakes import cmd_mistakes
 from cl.plots import cmd_plots
 from cl.release import cmd_release
 from cl.sanitize import cmd_sanitize
@@ -45,6 +48,13 @@ usage: ./course COMMAND [ARGS]
                                      changed since drawn; -v: list the rest, --force: redraw all
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
   extremes [--quick]                 the extremes matrix: finite, reported or silent NaN -> out/bench
+  handouts [labNN ...]               every command each handout shows, checked in its week's tree
+                                     (the lab's executable with --check: nothing is written)
+  claims [labNN ...] [--quick] [--solutions]
+                                     every number a handout quotes, reproduced by its command
+                                     (labs/*/claims.json); --quick: those that take seconds
+  mistakes [labNN ...] [--all-cases] the catalogued student mistakes (solutions/*/mistakes.json),
+                                     each planted: the grader must catch it (instructor)
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
   sanitize                           the whole test suite under AddressSanitizer and UBSan (build/asan)
   help                               this text
@@ -53,7 +63,7 @@ Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
+            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
 
 
 def main(argv):

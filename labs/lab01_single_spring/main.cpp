@@ -48,7 +48,7 @@ int sweep_mass_ratio(const cl::Scene& scene, const std::string& out) {
   if ((x_i - x_j).norm() == spring.rest_length) {
     throw cl::InputError(scene.source + ": springs[0]: --sweep-mass-ratio needs a spring away from its rest length");
   }
-  if (!out.empty()) cl::ensure_directory(out);  // only once the input is known good
+  cl::start_run(out);  // only once the input is known good
   cl::CsvTable table({"mass_ratio", "share_i", "share_j", "expected_share_i"});
   std::printf("%12s %14s %14s %14s\n", "m_i/m_j", "share_i", "share_j", "expected_i");
   constexpr int kPerDecade = 4;
@@ -72,7 +72,7 @@ int sweep_mass_ratio(const cl::Scene& scene, const std::string& out) {
 int run(const cl::CommonOptions& options, bool sweep) {
   const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   if (sweep) return sweep_mass_ratio(scene, options.out);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   const Eigen::Matrix3Xd before = scene.particles.x;
   Eigen::Matrix3Xd x = before;

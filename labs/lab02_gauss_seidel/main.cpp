@@ -75,7 +75,7 @@ void write_positions(const std::string& path, const Eigen::VectorXd& inv_mass, c
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab02::Order order = cl::lab02::order_from_name(lab.order);
   const Eigen::Matrix3Xd start = scene.particles.x;
 

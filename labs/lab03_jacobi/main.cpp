@@ -43,7 +43,7 @@ double median(std::vector<double> values) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const bool jacobi = options.method == "jacobi";
   const cl::lab03::Averaging averaging =
       lab.averaging == "none" ? cl::lab03::Averaging::kNone : cl::lab03::Averaging::kByCount;

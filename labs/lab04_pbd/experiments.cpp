@@ -35,7 +35,7 @@ PbdSettings frame_settings(const Scene& scene, const CommonOptions& options, con
 int run_sweep(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab,
               const std::vector<std::pair<int, int>>& points, const std::string& csv_name) {
   const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, scene_dir);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   std::vector<ConstraintSet> constraints;
   for (const cl::Scene& scene : scenes) {
     constraints.push_back(make_constraint_set(scene.particles.size(), scene.springs));

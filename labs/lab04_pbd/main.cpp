@@ -29,7 +29,7 @@ cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the br
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const std::string frames_dir = cl::join_path(options.out, "frames");
   if (options.frames > 0) cl::ensure_directory(frames_dir);
 

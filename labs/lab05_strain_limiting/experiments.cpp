@@ -66,7 +66,7 @@ int compare_limits(const char* lab_name, const std::string& scene_dir, const Com
   for (const std::string& name : lab.compare_limits) limits.push_back(limit_from(name));
   std::vector<LimitedSystem> systems;
   for (const Limit limit : limits) systems.push_back(make_limited_system(scene, limit));
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   cl::CsvTable series({"limit", "step", "time", "max_strain", "min_strain", "rms_strain_error", "total_energy",
                        "status"});
@@ -153,7 +153,7 @@ int stability_map(const char* lab_name, const std::string& scene_dir, const Comm
   if (!options.summary.empty()) throw cl::InputError("--summary: the map writes a CSV, not a run summary");
   // Checked once here, so the parallel runs below cannot fail on the scene.
   (void)make_limited_system(scene, limit);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   std::vector<MapCell> cells;
   for (const double stiffness : lab.map_stiffness) {

@@ -31,7 +31,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   const Limit limit = cl::lab05::limit_from(lab.limit);
   const cl::lab05::LimitedSystem system = cl::lab05::make_limited_system(scene, limit);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab05::StepSettings settings = cl::lab05::step_settings(scene, options, lab, limit);
 
   if (live.on) {  // the band's upper end; a rise of energy that the limiter contains is reported, not stopped at

@@ -92,7 +92,7 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
                     const LabOptions& lab) {
   std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, scene_dir);
   for (cl::Scene& scene : scenes) make_finite(lab_name, lab, scene);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   cl::CsvTable curves({"scene", "particles", "unknowns", "springs", "method", "iteration", "objective", "gap",
                        "relative_error", "seconds", "setup_seconds", "factorizations", "reference_converged",
                        "reference_last_decrease"});

@@ -44,7 +44,7 @@ std::string describe_springs(const cl::Scene& scene) {
 
 int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::lab06::load_finite_scene(kLab, CL_LAB_SCENE_DIR, options, lab, options.scene);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab06::Method method = method_of(options.method);
   cl::lab06::Solver solver(cl::lab06::problem_of(scene), method);
   cl::lab06::StepSettings settings;
@@ -184,5 +184,7 @@ int main(int argc, char** argv) {
       .capture_default_str();
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)")
       .delimiter(',');
+  app.modes({{"--convergence", {"--warmup", "--pd-cap", "--newton-cap", "--stop-gap", "--max-seconds", "--sweep-scenes"}}},
+            {"--method", "--tolerance", "--steps", "--live"});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

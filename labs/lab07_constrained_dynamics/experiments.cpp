@@ -135,7 +135,7 @@ int run_compare(const char* lab_name, const std::string& scene_dir, const Common
   if (lab.stabilize) throw cl::InputError("--stabilize: not with a comparison");
   cl::Scene scene = cl::load_scene_for(options, scene_dir);
   apply_stiffness(scene, lab.stiffness);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const std::vector<int> substeps = lab.compare_substeps.empty() ? std::vector<int>{1} : lab.compare_substeps;
   const cl::MovableMap map = cl::make_movable_map(scene.particles.inv_mass);
   const cl::lab04::ConstraintSet pbd_constraints =

@@ -36,7 +36,7 @@ cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the br
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   cl::lab07::apply_stiffness(scene, lab.stiffness);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   cl::lab07::StepSettings settings;
   settings.dt = scene.dt;

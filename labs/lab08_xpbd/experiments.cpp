@@ -22,7 +22,7 @@ FrameSettings frame_settings(const Scene& scene, const CommonOptions& options, c
 
 int run_sweep(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab) {
   const cl::Scene scene = cl::load_scene_for(options, scene_dir);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const std::optional<double> hanging = hanging_chain_stretch(scene.particles, scene.springs, scene.gravity);
 

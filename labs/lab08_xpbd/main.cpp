@@ -37,7 +37,7 @@ std::vector<double> multipliers_in_newtons(const Eigen::VectorXd& lambda, double
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   const cl::lab04::ConstraintSet constraints = cl::lab04::make_constraint_set(scene.particles.size(), scene.springs);
   const cl::lab08::FrameSettings settings = cl::lab08::frame_settings(scene, options, lab, options.iterations);

@@ -148,7 +148,7 @@ int run_sweep(const char* lab_name, const CommonOptions& options, const LabOptio
   if (lab.sweep_dt_max <= lab.sweep_dt_min) {
     throw cl::InputError("--sweep-dt-max: must be larger than --sweep-dt-min");
   }
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const int steps = options.steps >= 0 ? options.steps : lab.sweep_steps;
   if (steps < 1) throw cl::InputError("--steps: a sweep needs at least 1 step");
 

@@ -57,7 +57,7 @@ std::string describe_constraints_and_masses(const cl::Scene& scene) {
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab09::StableSettings settings =
       cl::lab09::settings_for(scene, options, lab, lab.geometric_stiffness == "on");
 

@@ -72,7 +72,7 @@ int run_converge(const char* lab_name, const std::string& scene_dir, const Commo
   if (!options.summary.empty() && !single) {
     throw cl::InputError("--summary: only for one scene and one level count (a sweep writes CSV files)");
   }
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
 
   cl::CsvTable samples({"scene", "nx", "levels", "iterations_per_level", "passes", "sweeps", "projections",
                         "seconds", "max_strain", "rms_strain"});

@@ -66,7 +66,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     };
     return cl::run_live(scene, live, run, options.summary);
   }
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const std::string frames_dir = cl::join_path(options.out, "frames");
   if (options.frames > 0) cl::ensure_directory(frames_dir);
 

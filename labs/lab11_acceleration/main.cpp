@@ -31,7 +31,7 @@ cl::LiveOptions live;  // --live [PORT]: the scene steps beside a page in the br
 int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab11::method_from_name(options.method);
   cl::Scene scene = std::move(cl::lab11::load(options, {}, method, CL_LAB_SCENE_DIR).front());
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   cl::lab11::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   cl::lab11::Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
@@ -79,7 +79,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   const bool pd = cl::lab11::minimises_objective(method);
   // Every refusal before any output.
   const std::vector<cl::Scene> scenes = cl::lab11::load(options, lab.sweep_scenes, method, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   cl::CsvTable table({"scene", "method", "rho", "history", "iteration", "objective", "objective_error", "max_strain",
                       "omega", "restarted", "seconds", "setup_seconds"});
   const std::vector<double> targets = pd ? std::vector<double>{1e-2, 1e-4, 1e-6} : std::vector<double>{lab.strain_target};
@@ -163,6 +163,7 @@ int main(int argc, char** argv) {
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
   app.add_option("--strain-target", lab.strain_target, "--convergence, PBD methods: the max strain to reach")
       .positive().capture_default_str().only_for_methods({"jacobi", "jacobi-chebyshev", "gauss-seidel"});
+  app.modes({{"--convergence", {"--sweep-scenes", "--strain-target"}}}, {"--steps", "--live"});
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1) (the iteration would not converge)");
     if (!(lab.settings.gamma < 2.0)) throw cl::InputError("--gamma: " + cl::format_double(lab.settings.gamma) + " is not in (0, 2)");

@@ -35,7 +35,7 @@ int run_steps(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab12::method_from_name(options.method);
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   cl::require_finite_springs(scene, "VBD minimises finite springs' energy");
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   cl::lab12::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   cl::lab12::Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
@@ -81,7 +81,7 @@ int run_convergence(const cl::CommonOptions& options, LabOptions lab) {
   const Method method = cl::lab12::method_from_name(options.method);
   const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, CL_LAB_SCENE_DIR);
   for (const cl::Scene& scene : scenes) cl::require_finite_springs(scene, "VBD minimises finite springs' energy");
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   cl::CsvTable table({"scene", "method", "init", "rho", "colours", "threads", "iteration", "objective",
                       "objective_error", "omega", "restarted", "seconds"});
   const std::vector<double> targets{1e-2, 1e-4, 1e-6};
@@ -137,7 +137,7 @@ int run_stability(const cl::CommonOptions& options, const LabOptions& lab) {
   const Method method = cl::lab12::method_from_name(options.method);
   if (method == Method::kVbdChebyshev && lab.estimate) throw cl::InputError("--stability: vbd-chebyshev needs --rho");
   const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const std::vector<cl::lab12::StabilityCell> cells = cl::lab12::stability_cells(scene, method, lab.settings);
   std::printf("%s", cl::lab12::stability_markdown(cells).c_str());
   if (!options.out.empty()) cl::lab12::stability_csv(cells).write(cl::join_path(options.out, "stability.csv"));
@@ -170,6 +170,7 @@ int main(int argc, char** argv) {
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
   app.add_flag("--stability", lab.stability, "experiment 2: every k, dt and K of the table on --scene (stability.csv)");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
+  app.modes({{"--convergence", {"--sweep-scenes"}}, {"--stability", {}}}, {"--steps", "--live"});
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;

@@ -68,7 +68,7 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
   std::vector<Warm> warms;
   for (const std::string& w : lab.warms) warms.push_back(warm_from_name(w));
   const std::vector<Scene> scenes = load_scenes(options, lab.sweep_scenes, scene_dir);
-  if (!options.out.empty()) ensure_directory(options.out);
+  start_run(options);
 
   CsvTable curves({"scene", "stiffness", "method", "start", "warm", "iteration", "seconds", "distance",
                    "force_error"});

@@ -58,6 +58,10 @@ int main(int argc, char** argv) {
   app.add_option("--newton-cap", lab.newton_cap, "--convergence: the most Newton iterations (both Newtons)")
       .range(1, 100000).capture_default_str();
   app.add_option("--pd-cap", lab.pd_cap, "--convergence: the most PD iterations").range(1, 1000000).capture_default_str();
+  app.modes({{"--convergence", {"--sweep-scenes", "--stiffnesses", "--starts", "--warms", "--warmup", "--newton-cap",
+                                 "--pd-cap"}}},
+            {"--method", "--iterations", "--tolerance", "--steps", "--start", "--warm", "--summary",
+             "--frames", "--live"});
   return cl::run_main(app, argc, argv, [&] {
     // CHOLMOD's BLAS on one thread: the solves are small, OpenBLAS's idle
     // threads spin (half of a 32² run's time went to sched_yield), and the

@@ -122,7 +122,7 @@ int run_scene(const char* lab_name, const std::string& scene_dir, const CommonOp
               const LiveOptions& live) {
   Scene scene = load(scene_dir, options, lab);
   if (live.on) return run_live_scene(lab_name, options, lab, scene, live);
-  if (!options.out.empty()) ensure_directory(options.out);
+  start_run(options);
   if (options.method != "constrained-newton") return run_lab06(lab_name, options, scene);
   Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
   Settings& settings = lab.settings;

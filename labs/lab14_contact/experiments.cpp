@@ -64,6 +64,7 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
                    "--drape writes drape.csv, not one run's summary");
   if (lab.friction) throw InputError("--friction: --drape sweeps --frictions instead");
   const Scene loaded = load_scene_for(options, scene_dir);
+  start_run(options);
   double mass = 0.0;
   for (Eigen::Index i = 0; i < loaded.particles.size(); ++i) {
     if (loaded.particles.inv_mass[i] > 0.0) mass += 1.0 / loaded.particles.inv_mass[i];
@@ -101,10 +102,7 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
                   per_step, rested ? std::to_string(rest_from * scene.dt).substr(0, 6).c_str() : "-");
     }
   }
-  if (!options.out.empty()) {
-    ensure_directory(options.out);
-    table.write(join_path(options.out, "drape.csv"));
-  }
+  if (!options.out.empty()) table.write(join_path(options.out, "drape.csv"));
   return 0;
 }
 
@@ -122,6 +120,7 @@ int run_incline(const char* lab_name, const CommonOptions& options, const LabOpt
                        std::to_string(angles[a]) + ")");
     }
   }
+  start_run(options);
   constexpr int kSteps = 100;
   CsvTable table({"method", "friction", "angle_deg", "tan_angle", "sticks", "acceleration", "coulomb_acceleration"});
   std::printf("%s --incline: a 1 kg particle on a plane tilted by θ, %d steps of 1/60 s, K = %d\n", lab_name, kSteps,
@@ -152,10 +151,7 @@ int run_incline(const char* lab_name, const CommonOptions& options, const LabOpt
                   std::atan(mu) * 180.0 / kPi);
     }
   }
-  if (!options.out.empty()) {
-    ensure_directory(options.out);
-    table.write(join_path(options.out, "incline.csv"));
-  }
+  if (!options.out.empty()) table.write(join_path(options.out, "incline.csv"));
   return 0;
 }
 

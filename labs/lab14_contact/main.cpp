@@ -50,7 +50,7 @@ int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene&
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
   if (live.on) return run_live(options, lab, scene);
-  if (!options.out.empty()) cl::ensure_directory(options.out);
+  cl::start_run(options);
   const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
   cl::lab14::ContactStepper stepper(scene, settings);
   cl::FrameOutput output =

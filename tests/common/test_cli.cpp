@@ -1,9 +1,12 @@
 // The shared command line: scene lookup and the exit-code mapping of run_main.
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <map>
 #include <sstream>
 #include <utility>
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <catch2/catch.hpp>
@@ -117,6 +120,86 @@ TEST_CASE("a flag the chosen method does not use is refused in one line", "[comm
   CHECK(run_line({"--iterations", "abc"}).second == "probe: --iterations: 'abc' is not an integer (see --help)\n");
   CHECK(run_line({"--seed", "1x"}).second == "probe: --seed: '1x' is not an integer (see --help)\n");
   CHECK(run_line({"--seed", "12"}).first == 0);
+}
+
+namespace {
+// A CommandLine with a mode (--convergence, which alone reads --warmup) and a
+// run-only --steps; the exit code, stdout and stderr of one call, whose body
+// records whether it got past start_run.
+struct Outcome {
+  int code;
+  std::string out, err;
+  bool worked;
+};
+
+Outcome run_modes(std::vector<std::string> arguments) {
+  cl::CommandLine line{"test", "probe"};
+  cl::CommonOptions options = cl::lab_defaults("two-particles");
+  cl::add_common_options(line, options, cl::kFlagSteps | cl::kFlagOut);
+  bool convergence = false;
+  int warmup = 0;
+  line.add_flag("--convergence", convergence, "a mode");
+  line.add_option("--warmup", warmup, "read by --convergence only");
+  line.modes({{"--convergence", {"--warmup"}}}, {"--steps"});
+  arguments.insert(arguments.begin(), "probe");
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  std::ostringstream out, err;
+  std::streambuf* const saved_out = std::cout.rdbuf(out.rdbuf());
+  std::streambuf* const saved_err = std::cerr.rdbuf(err.rdbuf());
+  bool worked = false;
+  const int code = cl::run_main(line, static_cast<int>(argv.size()), argv.data(), [&] {
+    (void)cl::load_scene_for(options, kLab01Scenes);
+    cl::start_run(options);
+    worked = true;
+    return 0;
+  });
+  std::cout.rdbuf(saved_out);
+  std::cerr.rdbuf(saved_err);
+  return {code, out.str(), err.str(), worked};
+}
+}  // namespace
+
+TEST_CASE("--check loads the scene, says what would run and stops where the run starts", "[common][cli]") {
+  const std::filesystem::path folder =
+      std::filesystem::temp_directory_path() / ("cl-check-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(folder);
+  const Outcome checked = run_modes({"--check", "--out", folder.string()});
+  CHECK(checked.code == 0);
+  CHECK_FALSE(checked.worked);
+  CHECK_THAT(checked.out, Contains("probe: check: ok, would run two-particles") && Contains("writes " + folder.string()));
+  CHECK(checked.err.empty());
+  CHECK_FALSE(std::filesystem::exists(folder));
+  // Without --check the same call makes the folder and does the work.
+  const Outcome ran = run_modes({"--out", folder.string()});
+  CHECK(ran.code == 0);
+  CHECK(ran.worked);
+  CHECK(std::filesystem::is_directory(folder));
+  std::filesystem::remove_all(folder);
+  // A refusal under --check is the run's refusal: exit 2, one line, nothing on stdout.
+  const Outcome refused = run_modes({"--check", "--steps", "-3"});
+  CHECK(refused.code == 2);
+  CHECK(refused.out.empty());
+  CHECK_FALSE(refused.worked);
+}
+
+TEST_CASE("a flag the chosen mode does not read is refused in one line", "[common][cli]") {
+  CHECK(run_modes({"--convergence", "--warmup", "3"}).code == 0);
+  CHECK(run_modes({"--steps", "3"}).code == 0);
+  const Outcome unread = run_modes({"--warmup", "3"});
+  CHECK(unread.code == 2);
+  CHECK(unread.err == "probe: --warmup: a run does not read it (only --convergence does)\n");
+  const Outcome run_only = run_modes({"--convergence", "--steps", "3"});
+  CHECK(run_only.code == 2);
+  CHECK(run_only.err == "probe: --steps: --convergence does not read it (only a run does)\n");
+}
+
+TEST_CASE("an unknown option is named and the program's options listed", "[common][cli]") {
+  const Outcome unknown = run_modes({"--rho", "0.5"});
+  CHECK(unknown.code == 2);
+  CHECK_THAT(unknown.err, Catch::Matchers::StartsWith("probe: unknown option --rho (options: ") &&
+                              Contains("--steps") && Contains("--warmup") && Contains("--check"));
+  CHECK(std::count(unknown.err.begin(), unknown.err.end(), '\n') == 1);
 }
 
 TEST_CASE("run_main maps each outcome to its exit code", "[common][cli]") {

@@ -14,12 +14,15 @@ from . import grade
 from .autograder import check_autograder
 from .base import BIN, BUILD, ROOT, CourseError, show
 from .build import BuildFailure, build_targets, configure
+from .claims import run_claims
 from .demo import index_links, run_demos, write_index, write_views
 from .fuzz import check_fuzz
 from .grading import Grader, write_results
+from .handouts import check_handouts
 from .labs import lab_dirs, lab_targets, manifest, reject_lines
 from .live_checks import check_live
 from .measure import check_measurements
+from .mistakes import catalogue, run_mistakes
 from .plots import run_plots
 from .release import is_release
 from .sanitize import check_sanitize, start_sanitize
@@ -269,6 +272,46 @@ def check_views(checks, out, labs):
                   else f"{show(index)}: {len(missing)} links do not resolve", missing[:5])
 
 
+def check_handout_commands(checks, labs):
+    """Every command of every handout runs in its week's tree (--check)."""
+    for result in check_handouts(labs):
+        where = f"week {result.week:02d}'s tree" if result.week else "their weeks' trees"
+        checks.record(not result.problems, f"handout {result.page}: {result.checked - len(result.problems)}/"
+                      f"{result.checked} commands run in {where}", result.problems)
+
+
+def check_claims(checks, labs):
+    """The quick claims of every lab, with the reference."""
+    try:
+        results = run_claims(labs, quick=True, solutions=True)
+    except CourseError as error:
+        checks.record(False, f"claims: {error}", error.details)
+        return
+    for lab, (held, total, failures) in results.items():
+        checks.record(not failures, f"claims {lab} (quick, reference): {held}/{total} hold", failures)
+
+
+# The newest labs' catalogues whole, and the first entry of every other lab's
+# (docs/DESIGN.md §4); ./course mistakes runs them all.
+MISTAKES_WHOLE = 2
+
+
+def check_mistakes(checks, labs):
+    with_catalogue = [lab for lab in labs if catalogue(lab)]
+    whole, first = with_catalogue[-MISTAKES_WHOLE:], with_catalogue[:-MISTAKES_WHOLE]
+    try:
+        results = {**run_mistakes(first, limit=1, log=lambda _line: None),
+                   **run_mistakes(whole, log=lambda _line: None)}
+    except CourseError as error:
+        checks.record(False, f"mistakes: {error}", error.details)
+        return
+    for lab, (caught, planted, lines) in results.items():
+        failing = [line.strip() for line in lines if line.startswith("  FAIL")]
+        checks.record(caught == planted and not failing,
+                      f"mistakes {lab}: {caught}/{planted} planted mistakes caught"
+                      f"{'' if lab in whole else ' (its first entry)'}", failing)
+
+
 # The house's own limits (docs/DESIGN.md §1): a lab's driver holds only its
 # flags, its dispatch and one run's report; a tools/cl module one concern.
 # Checked, because both crept past them unnoticed (issue 35: 201 and 523).
@@ -339,6 +382,10 @@ def cmd_test(argv):
             check_demo(checks, out, labs)
         with checks.timed("rejects"):
             check_rejects(checks, labs)
+        with checks.timed("handouts: every command in its week's tree (--check)"):
+            check_handout_commands(checks, labs)
+        with checks.timed("claims --quick (the reference)"):
+            check_claims(checks, labs)
         check_measurements(checks, out)
     with checks.timed("plots (every figure, redrawn)"):
         for script, outcome in run_plots(out, echo=False).items():
@@ -356,6 +403,8 @@ def cmd_test(argv):
             check_student_loop(checks)
         with checks.timed("autograder (a bundle, five submissions)"):
             check_autograder(checks)
+        with checks.timed("mistakes: the newest labs' catalogues, one entry of the others"):
+            check_mistakes(checks, labs)
         if sanitizing is not None:
             check_sanitize(checks, sanitizing)
     return checks.finish()

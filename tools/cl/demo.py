@@ -11,6 +11,7 @@ import sys
 from html.parser import HTMLParser
 from pathlib import Path
 
+from . import grade
 from .base import ROOT, CourseError, show, under_root
 from .build import BuildFailure, build_targets, configure
 from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
@@ -199,7 +200,8 @@ def cmd_run(argv):
     lab = resolve_lab(token.removesuffix("_solution"))
     configure(log=sys.stderr)
     if solution and not manifest().get(lab, {}).get("reference"):
-        raise CourseError(f"no reference for {lab} here (solutions/{lab}/)", code=2)
+        raise CourseError(f"{token}: this tree has no reference of {grade.lab_id(lab)} yet (solutions/{lab}/ "
+                          f"comes after its deadline); run your own code: ./course run {grade.lab_id(lab)}", code=2)
     name = lab + ("_solution" if solution else "")
     try:
         build_targets([name], log=sys.stderr)

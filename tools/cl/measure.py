@@ -6,7 +6,8 @@ import sys
 
 from .base import BUILD, ROOT, CourseError, under_root
 from .build import BuildFailure, build_targets, configure
-from .labs import executable
+from . import grade
+from .labs import executable, manifest
 from .plots import plots_failed, run_plots
 
 MEASUREMENT_PLOTS = {"trade": ("bench_pareto.py", "bench_scaling.py"), "extremes": ("bench_extremes.py",)}
@@ -34,6 +35,11 @@ def measurement_command(program, argv):
                             help="also run the Google Benchmark programs (bench_*), ARGS pass through")
     args = parser.parse_args(argv)
     configure()
+    absent = [lab for lab, entry in manifest().items() if not entry.get("reference")]
+    if absent:
+        raise CourseError(f"./course {parser.prog.split()[-1]} is the instructor's: it runs every lab's reference, "
+                          f"and this tree has none for {grade.lab_id(absent[0])}"
+                          f"{' and later labs' if len(absent) > 1 else ''} (solutions/)", code=2)
     out = under_root(args.out)
     code, _ = run_measurement(program, ["--quick"] if args.quick else [], out)
     if plots_failed(run_plots(out, names=MEASUREMENT_PLOTS[program])):

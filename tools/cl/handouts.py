@@ -1,0 +1,331 @@
+"""./course handouts: every command a handout shows runs in its week's tree.
+
+A handout (labs/labNN_name/README.md) is read by a student with the release of
+week NN and nothing else (docs/DESIGN.md §4). Each command it shows, in a code
+block or in `backticks`, is checked against that tree without building it: the
+week's tree is read from what release_files() ships (the stubs of every lab,
+the references of the labs before NN), and a lab's executable is asked with
+--check (docs/DESIGN.md §3), which parses the flags and loads the scenes as the
+run would and writes nothing. The README's commands are checked in the week of
+the latest lab they name.
+
+A command fails when the week's tree would refuse it: a reference the week has
+not got (labNN_solution in week NN), a later week's lab, a flag or a scene
+refused, `./course plots` or `./course view` pointed at a folder no earlier
+command of the page writes, a `-t PATTERN` that matches no graded case, or a
+command that needs every lab's reference (the bench) shown without saying it
+is the instructor's.
+"""
+import argparse
+import re
+import shlex
+import subprocess
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from . import grade
+from .base import BIN, ROOT, CourseError
+from .build import BuildFailure, build_targets, configure
+from .labs import lab_dirs, manifest, resolve_lab
+
+# Commands that need every lab's reference or the instructor's tree: a handout
+# shows them only as the instructor's (the word within INSTRUCTOR_LINES above).
+INSTRUCTOR_COMMANDS = {"bench", "extremes", "fuzz", "sanitize", "release", "autograder"}
+INSTRUCTOR_PROGRAMS = re.compile(r"^(trade|extremes|bench_\w+)$")
+INSTRUCTOR_LINES = 4
+STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view"}
+# A usage line, not a command: a placeholder in capitals (DIR, PATTERN, ARGS) or labNN.
+TEMPLATE = re.compile(r"\b(labNN\w*|[A-Z]{2,}[A-Z0-9_]*)\b|…|\.\.\.")
+COMMAND = re.compile(r"^(\./course\s|build/bin/|lab\d\d_[a-z0-9_]+\s)")
+CHECK_SECONDS = 30
+
+
+@dataclass
+class Command:
+    line: int           # 1-based line in the page
+    text: str
+    instructor: bool    # the page says it is the instructor's
+
+
+@dataclass
+class PageResult:
+    page: str
+    week: int
+    checked: int = 0
+    templates: int = 0
+    problems: list = field(default_factory=list)
+
+
+def page_commands(path):
+    """The commands a page shows: indented or fenced code lines and inline code
+    spans that start with ./course or build/bin/ (comments and `\\` joins undone)."""
+    lines = path.read_text().splitlines()
+    found = []
+    fenced = False
+    pending = None
+    for number, raw in enumerate(lines, 1):
+        if raw.lstrip().startswith("```"):
+            fenced = not fenced
+            continue
+        block = fenced or raw.startswith("    ")
+        candidates = [raw.strip()] if block else re.findall(r"`([^`]+)`", raw)
+        for text in candidates:
+            if pending is not None:
+                text = pending + " " + text
+                pending = None
+            elif not COMMAND.match(text):
+                continue
+            text = re.sub(r"\s+#.*$", "", text).strip()
+            if text.endswith("\\"):
+                pending = text[:-1].strip()
+                continue
+            context = " ".join(lines[max(0, number - 1 - INSTRUCTOR_LINES):number]).lower()
+            found.append(Command(number, text, "instructor" in context))
+    return found
+
+
+def lab_number(name):
+    match = re.match(r"lab(\d\d)", name)
+    return int(match.group(1)) if match else None
+
+
+class Week:
+    """What the release of week `week` holds, read from the lab list: the stubs
+    of every lab, the references of the labs before it."""
+
+    def __init__(self, week):
+        self.week = week
+
+    def program(self, token):
+        """(the executable in build/bin, None) or (None, why the week has none)."""
+        solution = token.endswith("_solution")
+        try:
+            lab = resolve_lab(token.removesuffix("_solution"))
+        except CourseError as error:
+            return None, str(error)
+        number = lab_number(lab)
+        if number > self.week:
+            return None, f"{token}: lab {number:02d} is a later week's (this page is week {self.week:02d})"
+        if solution and number >= self.week:
+            return None, (f"{token}: week {self.week:02d}'s tree has no reference of lab {number:02d} "
+                          f"(use lab{number:02d}, the student's own code)")
+        return lab + ("_solution" if solution else ""), None
+
+
+def check_program(program, args, instructor_ok=False):
+    """Run PROGRAM ARGS --check from the course root; the problem, or None."""
+    path = BIN / program
+    if not path.is_file():
+        return f"{program} is not built"
+    try:
+        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True, text=True,
+                              timeout=CHECK_SECONDS, check=False)
+    except subprocess.TimeoutExpired:
+        return f"--check ran past {CHECK_SECONDS} s (a path that does not stop at its start)"
+    if done.returncode != 0 or "check: ok" not in done.stdout:
+        lines = done.stderr.strip().splitlines() or done.stdout.strip().splitlines() or ["(no output)"]
+        return f"--check exit {done.returncode}: {lines[-1]}"
+    return None
+
+
+def flag_value(args, flag):
+    for i, arg in enumerate(args):
+        if arg == flag and i + 1 < len(args):
+            return args[i + 1]
+        if arg.startswith(flag + "="):
+            return arg.split("=", 1)[1]
+    return None
+
+
+class PageChecker:
+    """Checks one page's commands in order: an earlier command's --out is what a
+    later plots or view may read."""
+
+    def __init__(self, week):
+        self.week = Week(week)
+        self.outs = []  # (folder, with --frames) written by earlier commands, relative to ROOT
+
+    def check(self, command):
+        try:
+            words = shlex.split(command.text)
+        except ValueError as error:
+            return f"does not parse as a shell command ({error})"
+        if re.fullmatch(r"lab\d\d_[a-z0-9_]+", words[0]):
+            return f"{words[0]} is not a command in the student's tree: write ./course run {words[0][:5]} ..."
+        if words[0].startswith("build/bin/"):
+            return self.check_binary(command, words[0][len("build/bin/"):], words[1:])
+        if len(words) < 2:
+            return None  # ./course alone prints its usage
+        sub, rest = words[1], words[2:]
+        if sub in INSTRUCTOR_COMMANDS:
+            return None if command.instructor else f"./course {sub} needs every lab's reference: say it is the instructor's"
+        if sub not in STUDENT_COMMANDS:
+            return f"./course has no command '{sub}'"
+        return getattr(self, f"check_{sub}", lambda _rest: None)(rest)
+
+    def check_binary(self, command, name, args):
+        if INSTRUCTOR_PROGRAMS.match(name):
+            if not command.instructor:
+                return f"build/bin/{name} needs every lab's reference: say it is the instructor's"
+            return None if name.startswith("bench_") else check_program(name, args)
+        program, why = self.week.program(name)
+        return why or self.run_checked(program, args)
+
+    def run_checked(self, program, args, extra=()):
+        problem = check_program(program, [*args, *extra])
+        out = flag_value(args, "--out")
+        if problem is None and out:
+            self.outs.append((Path(out), flag_value(args, "--frames") is not None))
+        return problem
+
+    def check_run(self, rest):
+        if not rest or rest[0].startswith("-"):
+            return "./course run needs a lab"
+        program, why = self.week.program(rest[0])
+        return why or self.run_checked(program, rest[1:])
+
+    def check_live(self, rest):
+        rest = list(rest)
+        port = flag_value(rest, "--port")
+        if port is not None:
+            index = rest.index("--port")
+            del rest[index:index + 2]
+        if not rest:
+            return "./course live needs a lab"
+        program, why = self.week.program(rest[0])
+        return why or check_program(program, [*rest[1:], "--live"])
+
+    def check_grade(self, rest):
+        parser = argparse.ArgumentParser(add_help=False)
+        parser.add_argument("labs", nargs="*")
+        parser.add_argument("-t")
+        parser.add_argument("-v", action="store_true")
+        parser.add_argument("--solutions", action="store_true")
+        parser.add_argument("--output")
+        try:
+            args = parser.parse_args(rest)
+        except SystemExit:
+            return "./course grade refuses these arguments"
+        for token in args.labs:
+            program, why = self.week.program(token + ("_solution" if args.solutions else ""))
+            if why:
+                return why
+            if args.t and not matching_cases(resolve_lab(token), args.t):
+                return f"-t {args.t}: matches no graded case of {token}"
+        return None
+
+    def check_plots(self, rest):
+        targets = [t for t in rest if not t.startswith("-")]
+        labs = [t for t in targets if re.fullmatch(r"lab\d\d(_\w+)?", t)]
+        folders = [Path(t) for t in targets if t not in labs]
+        folder = folders[0] if folders else Path("out")
+        if re.fullmatch(r"lab\d\d_\w+", folder.name):
+            roots = [folder]
+        else:
+            roots = [folder / resolve_lab(lab) for lab in labs] or [folder]
+        for root in roots:
+            if not any(is_under(out, root) for out, _ in self.outs) and not demo_writes(root):
+                return (f"./course plots reads {root}/, where no earlier command of this page writes "
+                        f"(give --out {root}/... or point plots at the folder)")
+        return None
+
+    def check_view(self, rest):
+        folders = []
+        skip = False
+        for word in rest:
+            if skip or word == "--output":
+                skip = not skip
+                continue
+            folders.append(Path(word))
+        for folder in folders:
+            if not any(out == folder and frames for out, frames in self.outs) and not demo_writes(folder):
+                return f"./course view {folder}: no earlier command of this page writes a trajectory there (--frames N --out {folder})"
+        return None
+
+
+def is_under(path, root):
+    return path == root or root in path.parents
+
+
+def demo_writes(folder):
+    """True for the folders ./course demo fills (out/ and out/labNN_name/...)."""
+    return folder == Path("out") or (len(folder.parts) >= 2 and folder.parts[0] == "out"
+                                     and re.fullmatch(r"lab\d\d_\w+", folder.parts[1]) is not None)
+
+
+_CASES = {}
+
+
+def matching_cases(lab, pattern):
+    if lab not in _CASES:
+        program = BIN / f"{lab}_tests_solution"
+        listed = subprocess.run([str(program), "--list-test-names-only"], capture_output=True, text=True,
+                                check=False).stdout if program.is_file() else ""
+        _CASES[lab] = [name.strip() for name in listed.splitlines() if name.strip()]
+    return [name for name in _CASES[lab] if grade.matches(name, pattern)]
+
+
+def check_page(path, week):
+    result = PageResult(str(path.relative_to(ROOT)), week)
+    checker = PageChecker(week)
+    for command in page_commands(path):
+        if TEMPLATE.search(command.text):
+            # A usage line is not run, but the programs it names must be in the week's tree.
+            result.templates += 1
+            for token in re.findall(r"\blab\d\d(?:_[a-z0-9_]+)?\b", command.text):
+                why = Week(week or 15).program(token)[1] if week else None
+                if why and not command.instructor:
+                    result.problems.append(f"line {command.line}: {command.text}\n            {why}")
+            continue
+        # The README's: the first week whose tree holds what the command names
+        # (labNN_solution: the week after NN's).
+        named = [int(n) + bool(solution) for n, solution in re.findall(r"\blab(\d\d)\w*?(_solution)?\b", command.text)]
+        page_week = week or max(named or [1])
+        checker.week = Week(page_week)
+        result.checked += 1
+        problem = checker.check(command)
+        if problem:
+            result.problems.append(f"line {command.line}: {command.text}\n            {problem}")
+    return result
+
+
+def needed_targets(labs):
+    targets = []
+    for lab in labs:
+        targets += [lab, f"{lab}_tests_solution"]
+        if manifest().get(lab, {}).get("reference"):
+            targets.append(f"{lab}_solution")
+    return targets + ["trade", "extremes"]
+
+
+def check_handouts(labs, log=print):
+    """One PageResult per lab's handout (and the README's, with every lab)."""
+    results = [check_page(ROOT / "labs" / lab / "README.md", lab_number(lab)) for lab in labs]
+    if set(labs) == set(lab_dirs()):
+        results.append(check_page(ROOT / "README.md", 0))
+    return results
+
+
+def cmd_handouts(argv):
+    parser = argparse.ArgumentParser(prog="course handouts",
+                                     description="check that every command of each lab's handout runs in "
+                                                 "its week's tree (by --check; nothing is written)")
+    parser.add_argument("labs", nargs="*", metavar="labNN", help="the labs (default: all, and README.md)")
+    args = parser.parse_args(argv)
+    labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
+    configure()
+    try:
+        build_targets(needed_targets(labs))
+    except BuildFailure as failure:
+        raise CourseError(str(failure), details=failure.lines) from None
+    failed = 0
+    for result in check_handouts(labs):
+        ok = not result.problems
+        print(f"handouts {result.page}: {result.checked - len(result.problems)}/{result.checked} commands run "
+              f"in week {result.week:02d}'s tree" if result.week else
+              f"handouts {result.page}: {result.checked - len(result.problems)}/{result.checked} commands run "
+              f"in their weeks' trees")
+        for problem in result.problems:
+            print(f"  FAIL {problem}")
+        failed += not ok
+    return 1 if failed else 0

@@ -1,0 +1,210 @@
+"""./course mistakes: the plausible mistakes a lab's grader must catch.
+
+Each lab keeps a catalogue in solutions/labNN_name/mistakes.json (beside the
+reference it patches, so it ships only after the deadline; the format:
+docs/DESIGN.md §4, "Mistakes"): a small patch of one student file, the graded
+cases it must fail, and, for a mistake the handout's Troubleshooting describes,
+the symptom it shows in a run. Each entry is planted in a scratch copy of the
+course (BUILD/mistakes-tree, kept between runs so that a rebuild is one file)
+whose student files are the reference: the lab's tests are built against it
+and the named cases must fail; with --all every graded case is run, and any
+other that fails is named (a mistake should cost points in its own task).
+Every Troubleshooting entry of a handout that names a mistake
+(<!-- mistake: ID -->) must have its entry, and its symptom must show.
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+from . import grade
+from .base import BUILD, ROOT, CourseError
+from .claims import read_value, run_command
+from .labs import lab_dirs, resolve_lab
+from .release import course_files
+
+TREE = BUILD / "mistakes-tree" / "course"
+CASE_TIMEOUT = 120
+MARKER = re.compile(r"<!--\s*mistake:\s*([\w-]+)\s*-->")
+
+
+def catalogue(lab):
+    path = ROOT / "solutions" / lab / "mistakes.json"
+    if not path.is_file():
+        return []
+    entries = json.loads(path.read_text())
+    for index, entry in enumerate(entries):
+        missing = {"id", "what", "file", "find", "replace", "fails"} - set(entry)
+        if missing:
+            raise CourseError(f"{path.relative_to(ROOT)}: [{index}]: missing {', '.join(sorted(missing))}", code=2)
+    return entries
+
+
+def write_if_changed(path, text):
+    """Write `text` (a new mtime, so the build sees it) unless the file already holds it."""
+    if path.is_file() and path.read_text() == text:
+        return
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+
+
+def sync_tree():
+    """BUILD/mistakes-tree/course: the course's files as they are now."""
+    for relative in course_files():
+        source = ROOT / relative
+        try:
+            write_if_changed(TREE / relative, source.read_text())
+        except UnicodeDecodeError:
+            target = TREE / relative
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if not target.is_file() or target.read_bytes() != source.read_bytes():
+                target.write_bytes(source.read_bytes())
+
+
+def tree_env():
+    # Keyed on paths relative to ROOT, the tree's compiles hit the main build's
+    # objects in ccache for every file but the planted one.
+    return dict(os.environ, CCACHE_BASEDIR=str(ROOT))
+
+
+def build(targets):
+    build_dir = TREE / "build"
+    if not (build_dir / "CMakeCache.txt").is_file():
+        done = subprocess.run(["cmake", "-S", str(TREE), "-B", str(build_dir), "-G", "Ninja",
+                               "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True, env=tree_env())
+        if done.returncode != 0:
+            raise CourseError("mistakes: the scratch tree does not configure", details=done.stdout.splitlines()[-10:])
+    done = subprocess.run(["cmake", "--build", str(build_dir), "--target", *targets, "-j", "2"],
+                          capture_output=True, text=True, env=tree_env())
+    errors = [line for line in done.stdout.splitlines() if "error" in line][:6]
+    return done.returncode == 0, errors
+
+
+def graded_cases(lab, program):
+    return grade.list_names(program, grade.lab_tag(lab))
+
+
+def case_fails(program, name):
+    try:
+        done = subprocess.run([str(program), name], capture_output=True, text=True, timeout=CASE_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        return True
+    return done.returncode != 0
+
+
+def check_symptom(lab, symptom):
+    """None when the planted build's run shows the symptom; else what it showed."""
+    with tempfile.TemporaryDirectory(prefix="cl-symptom-") as scratch:
+        scratch = Path(scratch)
+        output, code, _ = run_command(symptom["command"], False, scratch, CASE_TIMEOUT, bin_dir=TREE / "build" / "bin")
+        try:
+            value = read_value(symptom["read"], output, scratch)
+        except (LookupError, OSError, ValueError, KeyError, IndexError) as error:
+            return f"cannot read it (exit {code}): {error}"
+    expect = symptom["expect"]
+    shown = {"above": lambda v: float(v) > expect.get("above", 0),
+             "below": lambda v: float(v) < expect.get("below", 0),
+             "equals": lambda v: v == expect.get("equals"),
+             "not_equals": lambda v: v != expect.get("not_equals"),
+             "contains": lambda v: str(expect.get("contains")) in str(v)}
+    for kind, test in shown.items():
+        if kind in expect and not test(value):
+            return f"expected {kind} {expect[kind]}, got {value}"
+    return None
+
+
+def plant_all(lab, entries, every_case, log):
+    """(caught, lines) for one lab's entries, planted one at a time."""
+    references = {p.name: p.read_text() for p in (ROOT / "solutions" / lab).glob("*.cpp")}
+    for name, text in references.items():
+        write_if_changed(TREE / "labs" / lab / name, text)
+    program = TREE / "build" / "bin" / f"{lab}_tests"
+    caught, lines = 0, []
+    for entry in entries:
+        start = time.monotonic()
+        reference = references.get(entry["file"])
+        problem = None
+        if reference is None:
+            problem = f"solutions/{lab}/{entry['file']}: no such reference file"
+        elif reference.count(entry["find"]) != 1:
+            problem = f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
+        else:
+            write_if_changed(TREE / "labs" / lab / entry["file"], reference.replace(entry["find"], entry["replace"]))
+            built, errors = build([f"{lab}_tests", lab])
+            if not built:
+                problem = "the planted file does not build: " + " | ".join(errors)
+            else:
+                passing = [name for name in entry["fails"] if not case_fails(program, name)]
+                if passing:
+                    problem = "not caught: " + "; ".join(f'"{name}" passes' for name in passing)
+                elif entry.get("symptom"):
+                    shown = check_symptom(lab, entry["symptom"])
+                    if shown:
+                        problem = f"caught, but the handout's symptom does not show: {shown}"
+                others = []
+                if not problem and every_case:
+                    others = [c for c in graded_cases(lab, program) if c not in entry["fails"] and case_fails(program, c)]
+                if others:
+                    lines.append(f"  note {entry['id']}: also fails {'; '.join(others[:4])}")
+            write_if_changed(TREE / "labs" / lab / entry["file"], reference)
+        seconds = time.monotonic() - start
+        if problem:
+            lines.append(f"  FAIL {entry['id']} ({entry['what']}): {problem}")
+        else:
+            caught += 1
+            log(f"  ok   {entry['id']}: {', '.join(entry['fails'])} fail ({seconds:.0f} s)")
+    for name in references:
+        write_if_changed(TREE / "labs" / lab / name, (ROOT / "labs" / lab / name).read_text())
+    return caught, lines
+
+
+def troubleshooting_gaps(lab, entries):
+    """Markers in the handout without an entry, and entries marked as
+    Troubleshooting whose marker is not in the handout."""
+    page = (ROOT / "labs" / lab / "README.md").read_text()
+    marked = set(MARKER.findall(page))
+    ids = {entry["id"] for entry in entries}
+    gaps = [f"  FAIL the handout marks '{m}', which solutions/{lab}/mistakes.json does not have"
+            for m in sorted(marked - ids)]
+    for entry in entries:
+        if entry.get("troubleshooting") and entry["id"] not in marked:
+            gaps.append(f"  FAIL {entry['id']}: a Troubleshooting entry, not marked <!-- mistake: {entry['id']} -->")
+        if entry.get("troubleshooting") and not entry.get("symptom"):
+            gaps.append(f"  FAIL {entry['id']}: a Troubleshooting entry without its symptom")
+    return gaps
+
+
+def run_mistakes(labs, limit=None, every_case=False, log=print):
+    """{lab: (caught, planted, lines)}; `limit` plants at most that many entries of a lab."""
+    sync_tree()
+    results = {}
+    for lab in labs:
+        entries = catalogue(lab)
+        if not entries:
+            continue
+        planted = entries[:limit] if limit else entries
+        caught, lines = plant_all(lab, planted, every_case, log)
+        results[lab] = (caught, len(planted), lines + troubleshooting_gaps(lab, entries))
+    return results
+
+
+def cmd_mistakes(argv):
+    parser = argparse.ArgumentParser(prog="course mistakes",
+                                     description="plant each catalogued mistake (solutions/*/mistakes.json) "
+                                                 "and check the grader catches it")
+    parser.add_argument("labs", nargs="*", metavar="labNN", help="the labs (default: all with a catalogue)")
+    parser.add_argument("--all-cases", action="store_true",
+                        help="also run every other graded case, and name those a mistake fails too")
+    args = parser.parse_args(argv)
+    labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
+    failed = 0
+    for lab, (caught, planted, lines) in run_mistakes(labs, every_case=args.all_cases).items():
+        print(f"mistakes {lab}: {caught}/{planted} caught")
+        for line in lines:
+            print(line)
+        failed += caught < planted or any(line.startswith("  FAIL") for line in lines)
+    return 1 if failed else 0
