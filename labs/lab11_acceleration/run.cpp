@@ -41,6 +41,7 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   omp_set_num_threads(1);
   const Method method = method_from_name(options.method);
   Scene scene = std::move(load(options, {}, method, scene_dir).front());
+  start_run(options);  // --check stops here, before the estimate of rho runs your code
   Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
   std::optional<Solver> solver;

@@ -170,7 +170,7 @@ int main(int argc, char** argv) {
   app.add_flag("--convergence", lab.convergence, "one step to the minimum: convergence.csv and the targets' table");
   app.add_flag("--stability", lab.stability, "experiment 2: every k, dt and K of the table on --scene (stability.csv)");
   app.add_option("--sweep-scenes", lab.sweep_scenes, "--convergence: the scenes (default: --scene)").delimiter(',');
-  app.modes({{"--convergence", {"--sweep-scenes"}}, {"--stability", {}}}, {"--steps", "--live"});
+  app.modes({{"--convergence", {"--sweep-scenes"}}, {"--stability", {"--steps"}}}, {"--steps", "--live"});
   return cl::run_main(app, argc, argv, [&] {
     if (rho >= 1.0) throw cl::InputError("--rho: " + cl::format_double(rho) + " is not in [0, 1)");
     if (rho >= 0.0) lab.settings.rho = rho, lab.estimate = false;

@@ -26,6 +26,7 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   const Method method = method_from_name(options.method);
   Scene scene = load_scene_for(options, scene_dir);
   require_finite_springs(scene, "VBD minimises finite springs' energy");
+  start_run(options);  // --check stops here, before the colouring runs your code
   Settings& settings = lab.settings;
   settings.gravity = scene.gravity;
   std::optional<Solver> solver;

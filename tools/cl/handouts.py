@@ -33,7 +33,8 @@ from .labs import lab_dirs, manifest, resolve_lab
 INSTRUCTOR_COMMANDS = {"bench", "extremes", "fuzz", "sanitize", "release", "autograder"}
 INSTRUCTOR_PROGRAMS = re.compile(r"^(trade|extremes|bench_\w+)$")
 INSTRUCTOR_LINES = 4
-STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view"}
+STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view", "handouts", "claims"}
+INSTRUCTOR_COMMANDS |= {"mistakes"}
 # A usage line, not a command: a placeholder in capitals (DIR, PATTERN, ARGS) or labNN.
 TEMPLATE = re.compile(r"\b(labNN\w*|[A-Z]{2,}[A-Z0-9_]*)\b|…|\.\.\.")
 COMMAND = re.compile(r"^(\./course\s|build/bin/|lab\d\d_[a-z0-9_]+\s)")
@@ -63,7 +64,10 @@ def page_commands(path):
     found = []
     fenced = False
     pending = None
+    heading = ""
     for number, raw in enumerate(lines, 1):
+        if raw.startswith("#") and not fenced:
+            heading = raw.lower()
         if raw.lstrip().startswith("```"):
             fenced = not fenced
             continue
@@ -80,7 +84,7 @@ def page_commands(path):
                 pending = text[:-1].strip()
                 continue
             context = " ".join(lines[max(0, number - 1 - INSTRUCTOR_LINES):number]).lower()
-            found.append(Command(number, text, "instructor" in context))
+            found.append(Command(number, text, "instructor" in context or "instructor" in heading))
     return found
 
 
@@ -154,8 +158,8 @@ class PageChecker:
             return f"{words[0]} is not a command in the student's tree: write ./course run {words[0][:5]} ..."
         if words[0].startswith("build/bin/"):
             return self.check_binary(command, words[0][len("build/bin/"):], words[1:])
-        if len(words) < 2:
-            return None  # ./course alone prints its usage
+        if len(words) < 3:
+            return None  # `./course live` named in a sentence, or ./course alone: its usage
         sub, rest = words[1], words[2:]
         if sub in INSTRUCTOR_COMMANDS:
             return None if command.instructor else f"./course {sub} needs every lab's reference: say it is the instructor's"
@@ -185,7 +189,7 @@ class PageChecker:
         return why or self.run_checked(program, rest[1:])
 
     def check_live(self, rest):
-        rest = list(rest)
+        rest = [word for word in rest if word != "--bench"]  # ./course live's own
         port = flag_value(rest, "--port")
         if port is not None:
             index = rest.index("--port")
@@ -262,7 +266,8 @@ def matching_cases(lab, pattern):
         listed = subprocess.run([str(program), "--list-test-names-only"], capture_output=True, text=True,
                                 check=False).stdout if program.is_file() else ""
         _CASES[lab] = [name.strip() for name in listed.splitlines() if name.strip()]
-    return [name for name in _CASES[lab] if grade.matches(name, pattern)]
+    selected = grade.case_filter(pattern)
+    return [name for name in _CASES[lab] if selected(name)]
 
 
 def check_page(path, week):
@@ -315,7 +320,7 @@ def cmd_handouts(argv):
     labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
     configure()
     try:
-        build_targets(needed_targets(labs))
+        build_targets(needed_targets(labs), log=None)
     except BuildFailure as failure:
         raise CourseError(str(failure), details=failure.lines) from None
     failed = 0
