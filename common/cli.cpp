@@ -103,11 +103,13 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
         ->capture_default_str();
   }
   if (flags & kFlagDt) {
-    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(finite_number(false));
+    // The scene's own range (limits in common/scene.h): a step of 1e300 s overflows g Δt².
+    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")
+        ->check(finite_in(limits::kDt.low, limits::kDt.high));
   }
   if (flags & kFlagSteps) {
     app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")
-        ->check(integer_in(0, 100'000'000));
+        ->check(integer_in(0, limits::kMaxSteps));
   }
   if (flags & kFlagOut) app.add_option("--out", options.out, "directory for the CSV files");
   if (flags & kFlagSummary) app.add_option("--summary", options.summary, "write the run summary (JSON) here");
