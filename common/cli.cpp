@@ -103,9 +103,15 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
         ->capture_default_str();
   }
   if (flags & kFlagDt) {
-    // The scene's own range (limits in common/scene.h): a step of 1e300 s overflows g Δt².
-    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")
-        ->check(finite_in(limits::kDt.low, limits::kDt.high));
+    // The scene's own range and words (limits in common/scene.h): a step of 1e300 s overflows g Δt².
+    const CLI::Validator dt_range(
+        [](std::string& text) -> std::string {
+          double value = 0.0;
+          if (parse_finite(text, value) && limits::kDt.contains(value)) return {};
+          return "must be in " + limits::kDt.text() + " (got " + text + ")";
+        },
+        limits::kDt.text());
+    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(dt_range);
   }
   if (flags & kFlagSteps) {
     app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")

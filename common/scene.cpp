@@ -24,6 +24,10 @@ namespace fs = std::filesystem;
 
 std::string show(const json& value) {
   std::string text = value.dump();
+  // An integer written as a float dumps as "1000000000000.0": shown without the ".0".
+  if (value.is_number_float() && text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) {
+    text.resize(text.size() - 2);
+  }
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
 }
