@@ -349,7 +349,7 @@ void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
     }
   }
   // A width or height so small for nx, ny that a cell's area underflows to 0
-  // in double precision (an overflow is check_finite_geometry's): the
+  // in double precision (an overflow cannot happen: width, height <= 1e6 m): the
   // smaller spacing is named.
   const bool areas_ok = std::all_of(scene.triangles.begin(), scene.triangles.end(),
                                     [](const Triangle& triangle) { return triangle.rest_area != 0.0; });
