@@ -117,11 +117,19 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
         ->capture_default_str();
   }
   if (flags & kFlagDt) {
-    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(finite_number(false));
+    // The scene's own range and words (limits in common/scene.h): a step of 1e300 s overflows g Δt².
+    const CLI::Validator dt_range(
+        [](std::string& text) -> std::string {
+          double value = 0.0;
+          if (parse_finite(text, value) && limits::kDt.contains(value)) return {};
+          return "must be in " + limits::kDt.text() + " (got " + text + ")";
+        },
+        limits::kDt.text());
+    app.add_option("--dt", options.dt, "time step in seconds (default: the scene's)")->check(dt_range);
   }
   if (flags & kFlagSteps) {
     app.add_option("--steps", options.steps, "number of time steps (default: the scene's)")
-        ->check(integer_in(0, 100'000'000));
+        ->check(integer_in(0, limits::kMaxSteps));
   }
   if (flags & kFlagOut) app.add_option("--out", options.out, "directory for the CSV files");
   if (flags & kFlagSummary) app.add_option("--summary", options.summary, "write the run summary (JSON) here");

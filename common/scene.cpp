@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -21,14 +22,12 @@ namespace {
 using nlohmann::json;
 namespace fs = std::filesystem;
 
-// The generators' size caps: a cloth of 1024 × 1024 particles (about 200 MB
-// with its springs and triangles), a chain of as many. Larger is a typo, not a
-// scene: 4096² would take 3.5 GB before the first step.
-constexpr std::int64_t kMaxClothSide = 1024;
-constexpr std::int64_t kMaxChainLinks = kMaxClothSide * kMaxClothSide;
-
 std::string show(const json& value) {
   std::string text = value.dump();
+  // An integer written as a float dumps as "1000000000000.0": shown without the ".0".
+  if (value.is_number_float() && text.size() > 2 && text.compare(text.size() - 2, 2, ".0") == 0) {
+    text.resize(text.size() - 2);
+  }
   if (text.size() > 40) text = text.substr(0, 37) + "...";
   return text;
 }
@@ -68,35 +67,29 @@ class Reader {
     return result;
   }
 
-  double positive(const json& value, const std::string& field) const {
+  // A number in `range` (limits in scene.h): finite is not enough, since a
+  // mass of 1e160 or a speed of 1e300 overflows the first step's arithmetic.
+  double in(const json& value, const std::string& field, const Range& range) const {
     const double result = number(value, field);
-    if (!(result > 0.0)) fail(field, "must be > 0 (got " + show(value) + ")");
+    if (!range.contains(result)) fail(field, "must be in " + range.text() + " (got " + show(value) + ")");
     return result;
   }
 
-  // A mass in kg whose inverse, which the solvers use, is a finite double too.
-  double mass(const json& value, const std::string& field, double particles = 1.0) const {
-    const double result = positive(value, field);
-    if (!std::isfinite(particles / result)) {
-      fail(field, "too small: the inverse mass of a particle overflows a double (got " + show(value) + ")");
+  // An integer's value as a double: a JSON integer, or a number such as 1e12
+  // or 2.0 that is one (JSON has a single number type), so that a value out
+  // of range is told its range rather than that it is not an integer.
+  double whole(const json& value, const std::string& field) const {
+    if (value.is_number_unsigned()) return static_cast<double>(value.get<std::uint64_t>());
+    if (value.is_number_integer()) return static_cast<double>(value.get<std::int64_t>());
+    if (value.is_number_float()) {
+      const double result = value.get<double>();
+      if (std::isfinite(result) && result == std::trunc(result)) return result;
     }
-    return result;
+    fail(field, "must be an integer (got " + show(value) + ")");
   }
 
-  double non_negative(const json& value, const std::string& field) const {
-    const double result = number(value, field);
-    if (result < 0.0) fail(field, "must be >= 0 (got " + show(value) + ")");
-    return result;
-  }
-
-  std::int64_t integer(const json& value, const std::string& field) const {
-    if (!value.is_number_integer()) fail(field, "must be an integer (got " + show(value) + ")");
-    return value.get<std::int64_t>();
-  }
-
-  int integer_at_least(const json& value, const std::string& field, std::int64_t low,
-                       std::int64_t high = 100'000'000) const {
-    const std::int64_t result = integer(value, field);
+  int integer_in(const json& value, const std::string& field, int low, int high) const {
+    const double result = whole(value, field);
     if (result < low || result > high) {
       fail(field, "must be an integer in [" + std::to_string(low) + ", " + std::to_string(high) +
                       "] (got " + show(value) + ")");
@@ -105,23 +98,34 @@ class Reader {
   }
 
   int index(const json& value, const std::string& field, Eigen::Index count) const {
-    const std::int64_t result = integer(value, field);
-    if (result < 0 || result >= count) {
+    const double result = whole(value, field);
+    if (result < 0.0 || result >= static_cast<double>(count)) {
       fail(field, "index out of range [0, " + std::to_string(count) + ") (got " + show(value) + ")");
     }
     return static_cast<int>(result);
   }
 
-  Eigen::Vector3d vec3(const json& value, const std::string& field) const {
+  // Three numbers, each in `range` when one is given.
+  Eigen::Vector3d vec3(const json& value, const std::string& field, const Range* range = nullptr) const {
     if (!value.is_array() || value.size() != 3) {
       fail(field, "must be an array of 3 numbers (got " + show(value) + ")");
     }
     Eigen::Vector3d result;
     for (int axis = 0; axis < 3; ++axis) {
-      result[axis] = number(value[static_cast<std::size_t>(axis)],
-                            field + "[" + std::to_string(axis) + "]");
+      const json& component = value[static_cast<std::size_t>(axis)];
+      const std::string name = field + "[" + std::to_string(axis) + "]";
+      result[axis] = range ? in(component, name, *range) : number(component, name);
     }
     return result;
+  }
+
+  // A direction: any non-zero vector of finite numbers, returned with length 1.
+  Eigen::Vector3d direction(const json& value, const std::string& field) const {
+    Eigen::Vector3d result = vec3(value, field);
+    const double largest = result.cwiseAbs().maxCoeff();
+    if (!(largest > 0.0)) fail(field, "must not be the zero vector");
+    result /= largest;  // scaled first, so that 1e300s do not overflow the norm nor 1e-300s underflow it
+    return result.normalized();
   }
 
   bool boolean(const json& value, const std::string& field) const {
@@ -145,14 +149,14 @@ class Reader {
     return result;
   }
 
-  // Stiffness in N/m: a positive finite number or the string "inf" (a hard constraint).
+  // Stiffness in N/m: a number in limits::kStiffness or the string "inf" (a hard constraint).
   double stiffness(const json& value, const std::string& field) const {
-    if (value.is_string()) {
-      if (value.get<std::string>() == "inf") return kInfiniteStiffness;
-      fail(field, "must be a number > 0 or \"inf\" (got " + show(value) + ")");
-    }
-    if (!value.is_number()) fail(field, "must be a number > 0 or \"inf\" (got " + show(value) + ")");
-    return positive(value, field);
+    const std::string wanted = "must be a number in " + limits::kStiffness.text() + " or \"inf\" (got " + show(value) + ")";
+    if (value.is_string() && value.get<std::string>() == "inf") return kInfiniteStiffness;
+    if (!value.is_number()) fail(field, wanted);
+    const double result = number(value, field);
+    if (!limits::kStiffness.contains(result)) fail(field, wanted);
+    return result;
   }
 
   const json& array(const json& value, const std::string& field) const {
@@ -184,9 +188,9 @@ void read_particles(const Reader& reader, const json& list, Scene& scene) {
     reader.check_keys(entry, {"x", "v", "mass", "pinned"}, field);
     if (!entry.contains("x")) reader.fail(field + ".x", "missing (every particle needs a position)");
     const auto n = static_cast<Eigen::Index>(p);
-    scene.particles.x.col(n) = reader.vec3(entry["x"], field + ".x");
-    if (entry.contains("v")) scene.particles.v.col(n) = reader.vec3(entry["v"], field + ".v");
-    const double mass = entry.contains("mass") ? reader.mass(entry["mass"], field + ".mass") : 1.0;
+    scene.particles.x.col(n) = reader.vec3(entry["x"], field + ".x", &limits::kCoordinate);
+    if (entry.contains("v")) scene.particles.v.col(n) = reader.vec3(entry["v"], field + ".v", &limits::kVelocity);
+    const double mass = entry.contains("mass") ? reader.in(entry["mass"], field + ".mass", limits::kMass) : 1.0;
     const bool pinned = entry.contains("pinned") && reader.boolean(entry["pinned"], field + ".pinned");
     scene.particles.inv_mass[n] = pinned ? 0.0 : 1.0 / mass;
   }
@@ -207,7 +211,7 @@ void read_springs(const Reader& reader, const json& list, Scene& scene) {
     spring.j = reader.index(entry["j"], field + ".j", n);
     if (spring.i == spring.j) reader.fail(field, "i and j must differ (both " + std::to_string(spring.i) + ")");
     spring.rest_length = entry.contains("rest")
-                             ? reader.non_negative(entry["rest"], field + ".rest")
+                             ? reader.in(entry["rest"], field + ".rest", limits::kRest)
                              : (scene.particles.x.col(spring.i) - scene.particles.x.col(spring.j)).norm();
     if (entry.contains("stiffness")) spring.stiffness = reader.stiffness(entry["stiffness"], field + ".stiffness");
     scene.springs.push_back(spring);
@@ -220,10 +224,8 @@ double triangle_area(const Eigen::Matrix3Xd& x, int i, int j, int k) {
   return 0.5 * e1.cross(e2).norm();
 }
 
-// Zero area up to round-off, relative to the triangle's size. An area that
-// overflowed is not zero: check_finite_geometry refuses it by name.
+// Zero area up to round-off, relative to the triangle's size.
 bool degenerate_area(const Eigen::Matrix3Xd& x, int i, int j, int k, double area) {
-  if (!std::isfinite(area)) return false;
   const double longest = std::max({(x.col(i) - x.col(j)).squaredNorm(),
                                    (x.col(j) - x.col(k)).squaredNorm(),
                                    (x.col(k) - x.col(i)).squaredNorm()});
@@ -269,11 +271,12 @@ void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
                             "plane", "triangles"},
                     field);
   auto get = [&](const char* key) -> const json* { return cloth.contains(key) ? &cloth[key] : nullptr; };
-  const int nx = get("nx") ? reader.integer_at_least(*get("nx"), "cloth.nx", 2, kMaxClothSide) : 16;
-  const int ny = get("ny") ? reader.integer_at_least(*get("ny"), "cloth.ny", 2, kMaxClothSide) : nx;
-  const double width = get("width") ? reader.positive(*get("width"), "cloth.width") : 1.0;
-  const double height = get("height") ? reader.positive(*get("height"), "cloth.height") : 1.0;
-  const double mass = get("mass") ? reader.mass(*get("mass"), "cloth.mass", static_cast<double>(nx) * ny) : 1.0;
+  const int nx = get("nx") ? reader.integer_in(*get("nx"), "cloth.nx", 2, limits::kMaxClothSide) : 16;
+  const int ny = get("ny") ? reader.integer_in(*get("ny"), "cloth.ny", 2, limits::kMaxClothSide) : nx;
+  // Within ±width/2 across and [0, height] up: inside limits::kCoordinate.
+  const double width = get("width") ? reader.in(*get("width"), "cloth.width", limits::kLength) : 1.0;
+  const double height = get("height") ? reader.in(*get("height"), "cloth.height", limits::kLength) : 1.0;
+  const double mass = get("mass") ? reader.in(*get("mass"), "cloth.mass", limits::kMass) : 1.0;
   const double stiffness = get("stiffness") ? reader.stiffness(*get("stiffness"), "cloth.stiffness")
                                             : kInfiniteStiffness;
   const std::string plane = get("plane") ? reader.one_of(*get("plane"), "cloth.plane", {"xy", "xz"}) : "xy";
@@ -346,7 +349,7 @@ void generate_cloth(const Reader& reader, const json& cloth, Scene& scene) {
     }
   }
   // A width or height so small for nx, ny that a cell's area underflows to 0
-  // in double precision (an overflow is check_finite_geometry's): the
+  // in double precision (an overflow cannot happen: width, height <= 1e6 m): the
   // smaller spacing is named.
   const bool areas_ok = std::all_of(scene.triangles.begin(), scene.triangles.end(),
                                     [](const Triangle& triangle) { return triangle.rest_area != 0.0; });
@@ -362,16 +365,13 @@ void generate_chain(const Reader& reader, const json& chain, Scene& scene) {
   reader.require_object(chain, "chain");
   reader.check_keys(chain, {"links", "length", "mass", "direction", "origin", "pin", "stiffness"}, "chain");
   auto get = [&](const char* key) -> const json* { return chain.contains(key) ? &chain[key] : nullptr; };
-  const int links = get("links") ? reader.integer_at_least(*get("links"), "chain.links", 1, kMaxChainLinks) : 10;
-  const double length = get("length") ? reader.positive(*get("length"), "chain.length") : 1.0;
-  const double mass = get("mass") ? reader.mass(*get("mass"), "chain.mass") : 1.0;
-  Eigen::Vector3d direction(1.0, 0.0, 0.0);
-  if (get("direction")) {
-    direction = reader.vec3(*get("direction"), "chain.direction");
-    if (!(direction.norm() > 0.0)) reader.fail("chain.direction", "must not be the zero vector");
-    direction.normalize();
-  }
-  const Eigen::Vector3d origin = get("origin") ? reader.vec3(*get("origin"), "chain.origin") : Eigen::Vector3d::Zero();
+  const int links = get("links") ? reader.integer_in(*get("links"), "chain.links", 1, limits::kMaxChainLinks) : 10;
+  const double length = get("length") ? reader.in(*get("length"), "chain.length", limits::kLength) : 1.0;
+  const double mass = get("mass") ? reader.in(*get("mass"), "chain.mass", limits::kMass) : 1.0;
+  const Eigen::Vector3d direction =
+      get("direction") ? reader.direction(*get("direction"), "chain.direction") : Eigen::Vector3d(1.0, 0.0, 0.0);
+  const Eigen::Vector3d origin =
+      get("origin") ? reader.vec3(*get("origin"), "chain.origin", &limits::kCoordinate) : Eigen::Vector3d::Zero();
   const std::string pin = get("pin") ? reader.one_of(*get("pin"), "chain.pin", {"first", "last", "both", "none"}) : "first";
   const double stiffness = get("stiffness") ? reader.stiffness(*get("stiffness"), "chain.stiffness") : kInfiniteStiffness;
 
@@ -395,9 +395,9 @@ double next_symmetric(std::uint64_t& state) {
 void apply_jitter(const Reader& reader, const json& jitter, Scene& scene) {
   reader.require_object(jitter, "jitter");
   reader.check_keys(jitter, {"amplitude", "seed"}, "jitter");
-  const double amplitude = jitter.contains("amplitude") ? reader.non_negative(jitter["amplitude"], "jitter.amplitude") : 0.0;
+  const double amplitude = jitter.contains("amplitude") ? reader.in(jitter["amplitude"], "jitter.amplitude", limits::kRest) : 0.0;
   std::uint64_t state = jitter.contains("seed")
-                            ? static_cast<std::uint64_t>(reader.integer_at_least(jitter["seed"], "jitter.seed", 0, 2'000'000'000))
+                            ? static_cast<std::uint64_t>(reader.integer_in(jitter["seed"], "jitter.seed", 0, 2'000'000'000))
                             : 1u;
   for (Eigen::Index p = 0; p < scene.particles.size(); ++p) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -408,9 +408,8 @@ void apply_jitter(const Reader& reader, const json& jitter, Scene& scene) {
 }
 
 // Colliders (lab 14): a list of planes, spheres and capsules, each with its
-// own keys and a friction coefficient. Every point, and a capsule's length,
-// must be a finite distance from the origin: the contact tests take norms of
-// differences with the particles' positions.
+// own keys and a friction coefficient. Points lie in limits::kCoordinate, as
+// the particles do: the contact tests take norms of their differences.
 void read_colliders(const Reader& reader, const json& list, Scene& scene) {
   reader.array(list, "colliders");
   for (std::size_t c = 0; c < list.size(); ++c) {
@@ -438,26 +437,17 @@ void read_colliders(const Reader& reader, const json& list, Scene& scene) {
       if (!entry.contains(key)) reader.fail(field + "." + key, "missing (a " + type + " needs it)");
     }
     auto point = [&](const char* key) {
-      const Eigen::Vector3d value = reader.vec3(entry[key], field + "." + key);
-      if (!std::isfinite(value.norm())) reader.fail(field + "." + key, "too far from the origin (its norm overflows a double)");
-      return value;
+      return reader.vec3(entry[key], field + "." + key, &limits::kCoordinate);
     };
     if (collider.shape == ColliderShape::kPlane) {
       collider.a = point("point");
-      Eigen::Vector3d normal = reader.vec3(entry["normal"], field + ".normal");
-      const double largest = normal.cwiseAbs().maxCoeff();
-      if (!(largest > 0.0)) reader.fail(field + ".normal", "must not be the zero vector");
-      normal /= largest;  // scaled first, so that a normal of 1e300s does not overflow its norm
-      collider.normal = normal.normalized();
+      collider.normal = reader.direction(entry["normal"], field + ".normal");
     } else {
       collider.a = point(collider.shape == ColliderShape::kSphere ? "centre" : "a");
       collider.b = collider.shape == ColliderShape::kCapsule ? point("b") : collider.a;
-      collider.radius = reader.positive(entry["radius"], field + ".radius");
-      if (!std::isfinite((collider.b - collider.a).norm() + collider.a.norm() + collider.b.norm() + collider.radius)) {
-        reader.fail(field, "its size overflows a double (ends or radius too large)");
-      }
+      collider.radius = reader.in(entry["radius"], field + ".radius", limits::kLength);
     }
-    collider.friction = entry.contains("friction") ? reader.non_negative(entry["friction"], field + ".friction") : 0.0;
+    collider.friction = entry.contains("friction") ? reader.in(entry["friction"], field + ".friction", limits::kFriction) : 0.0;
     scene.colliders.push_back(collider);
   }
 }
@@ -550,28 +540,19 @@ class TrackingBuilder : public nlohmann::json_sax<json> {
   std::vector<Level> path_;
 };
 
-// Finite inputs can still make infinite geometry: positions 1e308 apart, a
-// chain of 1e308 m links, a jitter of 1e308. Every position, every spring's
-// rest and current length and every triangle's rest and current area must be
-// a finite double, or the solvers' first norm overflows. `field` names what
-// set the sizes.
-void check_finite_geometry(const Reader& reader, const Scene& scene, const std::string& field) {
+// A generator or the jitter can place particles past limits::kCoordinate
+// from fields that are each in range (a chain of 1024² links of 1 km, a
+// jitter of 1e6 m around a point 1e6 m out). `field` names what placed them.
+void check_positions(const Reader& reader, const Scene& scene, const std::string& field) {
   const Eigen::Matrix3Xd& x = scene.particles.x;
   for (Eigen::Index p = 0; p < x.cols(); ++p) {
-    if (!x.col(p).allFinite()) reader.fail(field, "positions overflow a double (particle " + std::to_string(p) + ")");
-  }
-  const bool listed = field == "particles";
-  for (std::size_t s = 0; s < scene.springs.size(); ++s) {
-    const Spring& spring = scene.springs[s];
-    if (!std::isfinite(spring.rest_length) || !std::isfinite((x.col(spring.i) - x.col(spring.j)).norm())) {
-      reader.fail(listed ? item("springs", s) : field, "its length overflows a double (particles too far apart)");
-    }
-  }
-  for (std::size_t t = 0; t < scene.triangles.size(); ++t) {
-    const Triangle& triangle = scene.triangles[t];
-    if (!std::isfinite(triangle.rest_area) ||
-        !std::isfinite(triangle_area(x, triangle.i, triangle.j, triangle.k))) {
-      reader.fail(listed ? item("triangles", t) : field, "its area overflows a double (particles too far apart)");
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!limits::kCoordinate.contains(x(axis, p))) {
+        std::ostringstream where;
+        where << x(axis, p);
+        reader.fail(field, "places particle " + std::to_string(p) + " at " + where.str() + " m on axis " +
+                               std::to_string(axis) + ", outside " + limits::kCoordinate.text());
+      }
     }
   }
 }
@@ -592,9 +573,9 @@ Scene parse_scene(const std::string& text, const std::string& source) {
   scene.source = source;
   scene.name = root.contains("name") ? reader.string(root["name"], "name") : fs::path(source).stem().string();
   if (root.contains("description")) reader.string(root["description"], "description");
-  if (root.contains("gravity")) scene.gravity = reader.vec3(root["gravity"], "gravity");
-  if (root.contains("dt")) scene.dt = reader.positive(root["dt"], "dt");
-  if (root.contains("steps")) scene.steps = reader.integer_at_least(root["steps"], "steps", 0);
+  if (root.contains("gravity")) scene.gravity = reader.vec3(root["gravity"], "gravity", &limits::kGravity);
+  if (root.contains("dt")) scene.dt = reader.in(root["dt"], "dt", limits::kDt);
+  if (root.contains("steps")) scene.steps = reader.integer_in(root["steps"], "steps", 0, limits::kMaxSteps);
 
   const int sources = static_cast<int>(root.contains("particles")) + static_cast<int>(root.contains("cloth")) +
                       static_cast<int>(root.contains("chain"));
@@ -613,16 +594,20 @@ Scene parse_scene(const std::string& text, const std::string& source) {
     if (root.contains("cloth")) generate_cloth(reader, root["cloth"], scene);
     if (root.contains("chain")) generate_chain(reader, root["chain"], scene);
   }
-  check_finite_geometry(reader, scene, root.contains("cloth") ? "cloth" : root.contains("chain") ? "chain" : "particles");
+  if (root.contains("chain")) check_positions(reader, scene, "chain");
   if (root.contains("jitter")) {
     apply_jitter(reader, root["jitter"], scene);
-    check_finite_geometry(reader, scene, "jitter.amplitude");
+    check_positions(reader, scene, "jitter.amplitude");
   }
   if (root.contains("colliders")) read_colliders(reader, root["colliders"], scene);
   return scene;
 }
 
 Scene load_scene(const std::string& path) {
+  std::error_code error;
+  // A folder opens as a stream on Linux and reads as empty text, which would
+  // be reported as malformed JSON.
+  if (fs::is_directory(path, error)) throw InputError(path + ": is a folder, not a scene file (give a .json file or a scene name)");
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError(path + ": cannot open scene file");
   std::ostringstream text;
@@ -670,6 +655,24 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
     known.pop_back();
   }
   throw InputError(flag + ": no scene named '" + name_or_path + "' (" + known + ")");
+}
+
+std::string Range::text() const {
+  // "1e+06" -> "1e6", "1e-09" -> "1e-9": the form a scene or a flag is written in.
+  auto shown = [](double value) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%g", value);
+    std::string text = buffer;
+    const std::size_t e = text.find('e');
+    if (e == std::string::npos) return text;
+    std::string exponent = text.substr(e + 1);
+    const bool negative = exponent[0] == '-';
+    exponent = exponent.substr(exponent.find_first_not_of("+-0"));
+    return text.substr(0, e + 1) + (negative ? "-" : "") + exponent;
+  };
+  std::string result = (open_low ? "(" : "[") + shown(low) + ", " + shown(high) + "]";
+  if (*unit != '\0') result += std::string(" ") + unit;
+  return result;
 }
 
 const char* shape_name(ColliderShape shape) {

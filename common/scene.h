@@ -19,8 +19,50 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// A static collider the cloth may touch (lab 14; docs/DESIGN.md §3). Every
-// number finite; `normal` has length 1; radius > 0; friction (Coulomb's μ) >= 0.
+// A closed or half-open interval of doubles with its unit, for messages:
+// "[1e-12, 1e12] kg", "(0, 1e6] m".
+struct Range {
+  double low;
+  double high;
+  bool open_low;     // (low, high]: low itself is refused (a radius of 0)
+  const char* unit;  // "" for a pure number
+  constexpr bool contains(double value) const {
+    return (open_low ? value > low : value >= low) && value <= high;
+  }
+  std::string text() const;
+};
+
+// The ranges of every number a scene (and the common flags --dt, --steps)
+// may give: one rule, in this one place, that the loader (scene.cpp), the
+// flags (cli.cpp), the promises the fuzzer checks
+// (tests/support/scene_promises.h) and docs/DESIGN.md §3 all follow. Each is
+// wide beyond any physical scene (a coordinate of 1000 km, a mass from a
+// nanogram to a billion tonnes) and narrow enough that a step's
+// arithmetic stays finite with over 250 orders of magnitude to spare: the
+// largest product a solver forms is about k Δt² / m ≤ 1e15 · 10² / 1e-18 =
+// 1e35 (a cloth's mass is shared by up to 1024² particles), and a length's
+// fourth power at most (2√3 · 1e6)⁴ ≈ 2e26.
+namespace limits {
+inline constexpr Range kCoordinate{-1e6, 1e6, false, "m"};  // a position's, a collider point's, per axis
+inline constexpr Range kLength{0.0, 1e6, true, "m"};        // radius, cloth width/height, chain link
+inline constexpr Range kRest{0.0, 1e6, false, "m"};         // a spring's rest length, the jitter amplitude
+inline constexpr Range kVelocity{-1e8, 1e8, false, "m/s"};  // per axis: a third of light's speed
+inline constexpr Range kGravity{-1e6, 1e6, false, "m/s²"};  // per axis: 1e5 g
+inline constexpr Range kMass{1e-12, 1e12, false, "kg"};     // a particle's, a chain's per particle, a cloth's total
+inline constexpr Range kStiffness{1e-6, 1e15, false, "N/m"};  // or "inf": 1/k and k/m stay finite
+inline constexpr Range kDt{1e-9, 10.0, false, "s"};          // 1/Δt² ≤ 1e18, g Δt² ≤ 2e8 m
+inline constexpr Range kFriction{0.0, 1e9, false, ""};       // Coulomb's μ; 1e3 already never slides
+inline constexpr int kMaxSteps = 100'000'000;
+// The generators' size caps: a cloth of 1024 × 1024 particles (about 200 MB
+// with its springs and triangles), a chain of as many. Larger is a typo, not a
+// scene: 4096² would take 3.5 GB before the first step.
+inline constexpr int kMaxClothSide = 1024;
+inline constexpr int kMaxChainLinks = kMaxClothSide * kMaxClothSide;
+}  // namespace limits
+
+// A static collider the cloth may touch (lab 14; docs/DESIGN.md §3). Points
+// in limits::kCoordinate; `normal` has length 1; radius in limits::kLength;
+// friction (Coulomb's μ) in limits::kFriction.
 enum class ColliderShape { kPlane, kSphere, kCapsule };
 struct Collider {
   ColliderShape shape = ColliderShape::kPlane;

@@ -85,9 +85,15 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
       {"stiffness negative", R"({"chain": {"links": 2, "stiffness": -5}})", "chain.stiffness"},
       {"chain too long", R"({"chain": {"links": 100000000}})", "chain.links"},
       {"duplicate key", R"({"particles": [{"x": [0,0,0], "x": [1,0,0]}]})", "particles[0].x"},
-      {"inverse mass overflows", R"({"particles": [{"x": [0,0,0], "mass": 1e-320}]})", "particles[0].mass"},
-      {"length overflows", R"({"particles": [{"x": [0,0,0]}, {"x": [1e200,0,0]}], "springs": [{"i": 0, "j": 1}]})",
-       "springs[0]"},
+      {"mass too small", R"({"particles": [{"x": [0,0,0], "mass": 1e-320}]})", "particles[0].mass: must be in"},
+      {"mass too large", R"({"particles": [{"x": [0,0,0], "mass": 1e160}]})", "particles[0].mass: must be in"},
+      {"velocity too large", R"({"particles": [{"x": [0,0,0], "v": [1e300,0,0]}]})", "particles[0].v[0]: must be in"},
+      {"position too far", R"({"particles": [{"x": [0,0,0]}, {"x": [1e200,0,0]}], "springs": [{"i": 0, "j": 1}]})",
+       "particles[1].x[0]: must be in"},
+      {"dt too large", R"({"dt": 1e300, "particles": [{"x": [0,0,0]}]})", "dt: must be in [1e-9, 10] s"},
+      {"steps past the range", R"({"steps": 1e12, "particles": [{"x": [0,0,0]}]})", "steps: must be an integer in"},
+      {"sphere radius too large", R"({"particles": [{"x": [0,0,0]}],
+          "colliders": [{"type": "sphere", "centre": [0,0,0], "radius": 1e308}]})", "colliders[0].radius: must be in"},
       {"cloth too wide", R"({"cloth": {"nx": 5000}})", "cloth.nx"},
       {"cloth cell area underflows", R"({"cloth": {"nx": 4, "width": 1e-200}})", "cloth.width"},
       {"cloth unknown pin", R"({"cloth": {"nx": 4, "pin": ["centre"]}})", "cloth.pin[0]"},
@@ -110,8 +116,9 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
 TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
   const cl::test::ScratchDir scratch("bad_cli");
   const fs::path dir = scratch.path();
-  for (const char* arguments : {"--no-such-flag", "--scene no-such-scene", "--scene /no/such/file.json",
-                                "--scene"}) {
+  const std::string folder = "--scene '" + dir.string() + "'";
+  for (const std::string& arguments : {std::string("--no-such-flag"), std::string("--scene no-such-scene"),
+                                       std::string("--scene /no/such/file.json"), std::string("--scene"), folder}) {
     CAPTURE(arguments);
     const RunResult result = run_probe(arguments, dir);
     CAPTURE(result.stderr_text);
@@ -119,4 +126,5 @@ TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
     CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
     CHECK_THAT(result.stderr_text, StartsWith("lab01_single_spring"));
   }
+  CHECK_THAT(run_probe(folder, dir).stderr_text, Contains("is a folder, not a scene file"));
 }

@@ -14,6 +14,7 @@
 #include "common/cli.h"
 #include "common/not_implemented.h"
 #include "common/timer.h"
+#include "tests/support/scene_promises.h"
 
 using Catch::Matchers::Contains;
 using Catch::Matchers::EndsWith;
@@ -213,6 +214,25 @@ TEST_CASE("run_main maps each outcome to its exit code", "[common][cli]") {
   CHECK(run_with({}, []() -> int { throw std::runtime_error("boom"); }) == 1);
 }
 
+TEST_CASE("--dt and --steps hold the scene's ranges", "[common][cli][limits]") {
+  std::ostringstream captured;
+  std::streambuf* const saved = std::cerr.rdbuf(captured.rdbuf());
+  const int huge = run_with({"--dt", "1e300"}, [] { return 0; });
+  const int tiny = run_with({"--dt", "1e-300"}, [] { return 0; });
+  const int ends = run_with({"--dt", "1e-9"}, [] { return 0; }) + run_with({"--dt", "10"}, [] { return 0; });
+  std::cerr.rdbuf(saved);
+  CHECK(huge == 2);
+  CHECK(tiny == 2);
+  CHECK(ends == 0);
+  std::istringstream lines(captured.str());
+  std::string line;
+  for (const char* value : {"1e300", "1e-300"}) {
+    REQUIRE(std::getline(lines, line));
+    CHECK_THAT(line, Contains("--dt: must be in [1e-9, 10] s (got " + std::string(value) + ")"));
+  }
+  CHECK_FALSE(std::getline(lines, line));  // one line each, and none for the range's ends
+}
+
 TEST_CASE("the timer counts forward", "[common][cli]") {
   const cl::Timer timer;
   const double first = timer.seconds();
@@ -241,7 +261,9 @@ TEST_CASE("every shipped scene loads", "[common][cli]") {
     const fs::path dir = lab.path() / "scenes";
     for (const std::string& name : cl::list_scene_names(dir.string())) {
       CAPTURE((dir / (name + ".json")).string());
-      CHECK_NOTHROW(cl::load_scene((dir / (name + ".json")).string()));
+      std::string broken = "(refused)";
+      CHECK_NOTHROW(broken = cl::test::broken_promise(cl::load_scene((dir / (name + ".json")).string())));
+      CHECK(broken.empty());  // inside every range of limits (common/scene.h)
       ++count;
     }
   }

@@ -1,4 +1,9 @@
 // Scene loading: defaults, generators, and that each rejection names its field.
+#include <cmath>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <catch2/catch.hpp>
 
 #include "common/scene.h"
@@ -98,7 +103,7 @@ TEST_CASE("each rejection names the field and index", "[common][scene]") {
   CHECK_THAT(rejection(R"({"particles": [], "colour": 1})"), Contains("colour: unknown key"));
   CHECK_THAT(rejection(R"({"particles": [{"v": [0,0,0]}]})"), Contains("particles[0].x: missing"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [0,0,0], "mass": 0}]})"),
-             Contains("particles[1].mass: must be > 0"));
+             Contains("particles[1].mass: must be in [1e-12, 1e12] kg (got 0)"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,1e999,0]}]})"), Contains("particles[0].x[1]"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 2}]})"),
              Contains("springs[0].j: index out of range"));
@@ -107,9 +112,9 @@ TEST_CASE("each rejection names the field and index", "[common][scene]") {
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 1, "j": 1}]})"),
              Contains("springs[0]: i and j must differ"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": -1}]})"),
-             Contains("springs[0].rest: must be >= 0"));
+             Contains("springs[0].rest: must be in [0, 1e6] m (got -1)"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "stiffness": 0}]})"),
-             Contains("springs[0].stiffness: must be > 0"));
+             Contains("springs[0].stiffness: must be a number in [1e-6, 1e15] N/m or \"inf\" (got 0)"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [2,0,0]}], "triangles": [{"i": 0, "j": 1, "k": 2}]})"),
              Contains("triangles[0]: zero rest area"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [0,1,0]}], "triangles": [{"i": 0, "j": 1, "k": 0}]})"),
@@ -171,15 +176,96 @@ TEST_CASE("each collider rejection names the field and index", "[common][scene]"
              Contains("colliders[0].radius: unknown key"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1},
                                    {"type": "sphere", "centre": [0,0,0], "radius": 0}]})"),
-             Contains("colliders[1].radius: must be > 0"));
+             Contains("colliders[1].radius: must be in (0, 1e6] m (got 0)"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1, "friction": -0.1}]})"),
-             Contains("colliders[0].friction: must be >= 0"));
+             Contains("colliders[0].friction: must be in [0, 1e9] (got -0.1)"));
   CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [0,0,0], "radius": 1}]})"),
              Contains("colliders[0].b: missing"));
   CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [-1.3e154,0,0], "b": [1.3e154,0,0], "radius": 1}]})"),
-             Contains("colliders[0]: its size overflows"));
+             Contains("colliders[0].a[0]: must be in [-1e6, 1e6] m"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [1e308,1e308,0], "radius": 1}]})"),
-             Contains("colliders[0].centre: too far from the origin"));
+             Contains("colliders[0].centre[0]: must be in [-1e6, 1e6] m"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,"a",0], "radius": 1}]})"),
              Contains("colliders[0].centre[1]: must be a number"));
+}
+
+TEST_CASE("a range prints as a scene or a flag would write it", "[common][scene][limits]") {
+  CHECK(cl::limits::kMass.text() == "[1e-12, 1e12] kg");
+  CHECK(cl::limits::kLength.text() == "(0, 1e6] m");
+  CHECK(cl::limits::kDt.text() == "[1e-9, 10] s");
+  CHECK(cl::limits::kFriction.text() == "[0, 1e9]");
+  CHECK(cl::limits::kLength.contains(1e6));
+  CHECK_FALSE(cl::limits::kLength.contains(0.0));
+  CHECK(cl::limits::kRest.contains(0.0));
+  CHECK_FALSE(cl::limits::kMass.contains(std::nan("")));
+}
+
+// Finite numbers whose arithmetic overflows in a step (½ m v², k Δt²/m,
+// x + v Δt, a length's fourth power): each refused by its field, with the
+// range it must lie in (docs/DESIGN.md §3).
+TEST_CASE("a finite number outside its range is refused naming the field and the range", "[common][scene][limits]") {
+  const std::string one = R"("particles": [{"x": [0,0,0]}])";
+  const std::string two = R"("particles": [{"x": [0,0,0]}, {"x": [1,0,0]}])";
+  const std::string sphere = R"({"particles": [{"x": [0,0,0]}], "colliders": [{"type": "sphere", "centre": [0,0,0], )";
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {R"({"particles": [{"x": [0,0,0], "mass": 1e160}]})", "particles[0].mass: must be in [1e-12, 1e12] kg (got 1e+160)"},
+      {R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0], "mass": 1e-13}]})", "particles[1].mass: must be in [1e-12, 1e12] kg"},
+      {R"({"particles": [{"x": [0,0,0], "mass": 1e-320}]})", "particles[0].mass: must be in [1e-12, 1e12] kg"},
+      {R"({"particles": [{"x": [0,0,0], "v": [0,1e300,0]}]})", "particles[0].v[1]: must be in [-1e8, 1e8] m/s (got 1e+300)"},
+      {R"({"particles": [{"x": [0,0,0], "v": [-1e300,0,0]}]})", "particles[0].v[0]: must be in [-1e8, 1e8] m/s"},
+      {R"({"particles": [{"x": [0,0,0]}, {"x": [0,0,1e300]}]})", "particles[1].x[2]: must be in [-1e6, 1e6] m"},
+      {R"({"particles": [{"x": [0,0,0]}, {"x": [1e200,0,0]}], "springs": [{"i": 0, "j": 1}]})",
+       "particles[1].x[0]: must be in [-1e6, 1e6] m"},
+      {"{" + two + R"(, "springs": [{"i": 0, "j": 1, "rest": 1e300}]})", "springs[0].rest: must be in [0, 1e6] m"},
+      {"{" + two + R"(, "springs": [{"i": 0, "j": 1, "stiffness": 1e300}]})", "springs[0].stiffness: must be a number in [1e-6, 1e15] N/m"},
+      {"{" + two + R"(, "springs": [{"i": 0, "j": 1, "stiffness": 1e-300}]})", "springs[0].stiffness: must be a number in [1e-6, 1e15] N/m"},
+      {"{" + one + R"(, "gravity": [0, -1e300, 0]})", "gravity[1]: must be in [-1e6, 1e6] m/s²"},
+      {"{" + one + R"(, "dt": 1e300})", "dt: must be in [1e-9, 10] s (got 1e+300)"},
+      {"{" + one + R"(, "dt": 1e-300})", "dt: must be in [1e-9, 10] s"},
+      {"{" + one + R"(, "steps": 1e12})", "steps: must be an integer in [0, 100000000]"},
+      {"{" + one + R"(, "steps": 100000001})", "steps: must be an integer in [0, 100000000]"},
+      {"{" + one + R"(, "steps": 2.5})", "steps: must be an integer (got 2.5)"},
+      {sphere + R"("radius": 1e308}]})", "colliders[0].radius: must be in (0, 1e6] m (got 1e+308)"},
+      {sphere + R"("radius": 1, "friction": 1e300}]})", "colliders[0].friction: must be in [0, 1e9]"},
+      {R"({"particles": [{"x": [0,0,0]}], "colliders": [{"type": "plane", "point": [0,-1e300,0], "normal": [0,1,0]}]})",
+       "colliders[0].point[1]: must be in [-1e6, 1e6] m"},
+      {R"({"cloth": {"nx": 4, "mass": 1e160}})", "cloth.mass: must be in [1e-12, 1e12] kg"},
+      {R"({"cloth": {"nx": 4, "width": 1e300}})", "cloth.width: must be in (0, 1e6] m"},
+      {R"({"cloth": {"nx": 4, "height": 2e6}})", "cloth.height: must be in (0, 1e6] m"},
+      {R"({"cloth": {"nx": 4, "stiffness": 1e16}})", "cloth.stiffness: must be a number in [1e-6, 1e15] N/m"},
+      {R"({"chain": {"links": 2, "length": 1e300}})", "chain.length: must be in (0, 1e6] m"},
+      {R"({"chain": {"links": 2, "mass": 1e160}})", "chain.mass: must be in [1e-12, 1e12] kg"},
+      {R"({"chain": {"links": 2, "origin": [1e300, 0, 0]}})", "chain.origin[0]: must be in [-1e6, 1e6] m"},
+      // Each field in range, the particles they place not: named by what placed them.
+      {R"({"chain": {"links": 2000, "length": 1000}})", "chain: places particle 1001 at 1.001e+06 m on axis 0"},
+      {R"({"chain": {"links": 2, "pin": "none"}, "jitter": {"amplitude": 1e300}})", "jitter.amplitude: must be in [0, 1e6] m"},
+      {R"({"particles": [{"x": [1e6,1e6,1e6]}], "jitter": {"amplitude": 1e6, "seed": 3}})",
+       "jitter.amplitude: places particle 0 at"},
+  };
+  for (const auto& [text, expected] : cases) {
+    CAPTURE(text);
+    CHECK_THAT(rejection(text), Contains("test.json: " + expected));
+  }
+}
+
+TEST_CASE("the ranges' own ends are accepted, and an integer may be written 1e2", "[common][scene][limits]") {
+  const cl::Scene low = parse(R"({"dt": 1e-9, "steps": 1e2, "gravity": [-1e6, 0, 1e6],
+      "particles": [{"x": [-1e6, 0, 1e6], "v": [1e8, -1e8, 0], "mass": 1e-12}, {"x": [1e6, 0, 0], "mass": 1e12}],
+      "springs": [{"i": 0, "j": 1, "stiffness": 1e-6}, {"i": 1, "j": 0, "stiffness": 1e15, "rest": 1e6}],
+      "colliders": [{"type": "sphere", "centre": [1e6, 1e6, 1e6], "radius": 1e6, "friction": 1e9}]})");
+  CHECK(low.dt == 1e-9);
+  CHECK(low.steps == 100);
+  CHECK(low.particles.inv_mass[0] == 1e12);
+  CHECK(low.springs[0].rest_length == Approx(std::sqrt(5.0) * 1e6));  // the default: the initial distance
+  const cl::Scene high = parse(R"({"dt": 10, "steps": 100000000, "chain": {"links": 1048576, "length": 0.9, "origin": [-1e6, 0, 0]}})");
+  CHECK(high.dt == 10.0);
+  CHECK(high.particles.size() == 1048577);
+  // A direction of tiny components is scaled before it is normalised, as a huge one.
+  const cl::Scene tiny = parse(R"({"chain": {"links": 1, "direction": [0, 1e-300, 0]}})");
+  CHECK_THAT(tiny.particles.x(1, 1), WithinAbs(1.0, 1e-15));
+}
+
+TEST_CASE("a folder given as the scene is named a folder, not malformed JSON", "[common][scene]") {
+  const std::string folder = std::string(CL_SOURCE_DIR) + "/labs";
+  CHECK_THROWS_WITH(cl::load_scene(folder), folder + ": is a folder, not a scene file (give a .json file or a scene name)");
 }
