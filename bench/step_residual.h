@@ -26,7 +26,8 @@ double step_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, c
 // at a solution φ = 0 and M(x − y) = Jᵀμ for some μ (J = ∂φ/∂x). Two parts:
 //   violation    sqrt(mean_e φ_e(x)²) over the springs with a movable end (m);
 //   stationarity the part of d = x − y that no constraint force explains:
-//                min_μ ‖d − M⁻¹Jᵀμ‖ (the norm above; = min_μ ‖M d − Jᵀμ‖_{M⁻¹} / sqrt(m_tot)),
+//                min_μ ‖d − M⁻¹Jᵀμ‖ (the norm above)
+//                    = min_μ ‖M d − Jᵀμ‖_{M⁻¹} / sqrt(m_tot),
 //                with μ from (J M⁻¹ Jᵀ + ε I) μ = J d, ε = 1e-10 × the mean
 //                of J M⁻¹ Jᵀ's diagonal. The cloths' springs are redundant
 //                (more springs than unknowns), so J M⁻¹ Jᵀ is singular; the

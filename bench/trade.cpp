@@ -793,7 +793,8 @@ int run(const Options& options) {
                    r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
                    r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance, r.relative_distance_hard,
                    r.residual_rms, r.relative_residual, r.hard_violation_rms, r.hard_stationarity_rms,
-                   r.relative_residual_hard, r.objective_gap, static_cast<long long>(r.horizon_steps), r.energy_drift, r.energy_drift_rel,
+                   r.relative_residual_hard, r.objective_gap, static_cast<long long>(r.horizon_steps), r.energy_drift,
+                   r.energy_drift_rel,
                    static_cast<long long>(r.on_front ? 1 : 0), csv_text(r.problem)});
   }
   table.write(cl::join_path(options.out, "trade.csv"));

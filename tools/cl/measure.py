@@ -121,9 +121,12 @@ def check_trade_accuracy(checks, table):
                 bad.append(f"{table.name} line {number} ({row['scene']} {row['method']} K={row['iterations']}): "
                            f"{column} = {row[column]!r}")
     ok = bool(rows) and not missing and not bad
-    checks.record(ok, f"trade --quick: {len(rows)} runs, each with {', '.join(TRADE_ACCURACY_COLUMNS)} finite"
-                  + (f" (missing: {', '.join(missing)})" if missing else "") + (f" ({len(bad)} not finite)" if bad else ""),
-                  bad[:20])
+    summary = f"trade --quick: {len(rows)} runs, each with {', '.join(TRADE_ACCURACY_COLUMNS)} finite"
+    if missing:
+        summary += f" (missing: {', '.join(missing)})"
+    if bad:
+        summary += f" ({len(bad)} not finite)"
+    checks.record(ok, summary, bad[:20])
 
 
 def check_micro(checks):
