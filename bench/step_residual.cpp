@@ -40,7 +40,8 @@ double step_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, c
   return mass > 0.0 ? problem.dt * problem.dt * std::sqrt(weighted / mass) : 0.0;
 }
 
-HardResidual hard_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) {
+HardResidual hard_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y,
+                           SpdFactorization* factor) {
   const MovableMap& map = problem.map;
   const Eigen::Index unknowns = map.unknowns();
   HardResidual residual;
@@ -85,12 +86,13 @@ HardResidual hard_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd
     SparseMatrix delassus = j_scaled * SparseMatrix(j.transpose());  // J M⁻¹ Jᵀ
     const double shift = 1e-10 * delassus.diagonal().mean();
     for (Eigen::Index e = 0; e < rows; ++e) delassus.coeffRef(e, e) += shift;
-    SpdFactorization factor;
-    if (!factor.factor(delassus)) {
+    SpdFactorization own;
+    SpdFactorization& solver = factor ? *factor : own;
+    if (!solver.refactor(delassus)) {
       residual.stationarity = std::numeric_limits<double>::quiet_NaN();
       return residual;
     }
-    const Eigen::VectorXd mu = factor.solve(Eigen::Map<const Eigen::VectorXd>(jd.data(), rows));
+    const Eigen::VectorXd mu = solver.solve(Eigen::Map<const Eigen::VectorXd>(jd.data(), rows));
     r -= inv_mass.asDiagonal() * (j.transpose() * mu);
   }
   residual.stationarity = std::sqrt(r.cwiseProduct(r).cwiseQuotient(inv_mass).sum() / mass);

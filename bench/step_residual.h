@@ -9,6 +9,7 @@
 //     ‖v‖ := sqrt(vᵀ M v / m_tot)   for a displacement v (3 per unknown).
 #include <Eigen/Core>
 
+#include "common/sparse.h"
 #include "labs/lab06_projective_dynamics/projective_dynamics.h"
 
 namespace cl::bench {
@@ -35,12 +36,16 @@ double step_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, c
 //                whose singular value² is below ε (m).
 // Both parts are lengths, so the residual is one vector (φ, the unexplained
 // move) with the norm sqrt(violation² + stationarity²) (m). Costs one sparse
-// Cholesky of the springs' size.
+// Cholesky of the springs' size; J M⁻¹ Jᵀ's pattern is the same at every x,
+// so a caller that passes the same `factor` for one problem's calls pays its
+// ordering and symbolic analysis once (SpdFactorization::refactor). NaN
+// stationarity when the shifted matrix does not factor.
 struct HardResidual {
   double violation = 0.0;     // m
   double stationarity = 0.0;  // m
   double norm() const;        // sqrt(violation² + stationarity²), m
 };
-HardResidual hard_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y);
+HardResidual hard_residual(const lab06::Problem& problem, const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y,
+                           SpdFactorization* factor = nullptr);
 
 }  // namespace cl::bench
