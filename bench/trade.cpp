@@ -1,17 +1,20 @@
 // The speed/accuracy trade (issue 12, docs/DESIGN.md §5): every method on the
 // same scenes over a range of iteration counts. Per run: wall time per step
 // (median of repeats), strain error, distance to a converged reference step,
-// and the energy drift over a fixed horizon. What each number means, and which
+// the step's residual and objective gap (bench/step_residual.h: unlike the
+// distance, defined where the step has several minimisers), and the energy
+// drift over a fixed horizon. What each number means, and which
 // problem each method converges to: bench/README.md.
 //
 //   trade [--quick] [--out DIR] [--scenes a,b] [--methods a,b] [--stiffness K] ...
 //
 // Writes DIR/trade.csv (one row per run), DIR/trade_scenes.csv (the scenes and
 // their reference steps), DIR/trade_fastest.csv (the fastest method to each
-// strain target) and DIR/trade_scaling.csv (time per iteration against size);
+// target of strain, distance and residual) and DIR/trade_scaling.csv (time per iteration against size);
 // the drape-N scenes (lab 14's contact methods against the constrained step
 // at convergence, trade_contact.cpp) DIR/trade_contact.csv.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -38,6 +41,7 @@
 #include "labs/lab06_projective_dynamics/simulation.h"
 #include "labs/lab13_constrained_newton/iteration.h"
 #include "methods.h"
+#include "step_residual.h"
 #include "trade_contact.h"
 
 namespace {
@@ -133,6 +137,11 @@ struct Run {
   double step_seconds = 0, setup_seconds = 0;
   double max_strain = 0, rms_strain = 0, distance = 0, distance_max = 0, relative_distance = 0;
   double relative_distance_hard = 0;  // to the hard step (NaN when it could not be computed)
+  // The step's residuals at the run's result (bench/step_residual.h), each
+  // over the shared start's: the k step's (every run) and the hard step's.
+  double residual_rms = 0, relative_residual = 0;
+  double hard_violation_rms = 0, hard_stationarity_rms = 0, relative_residual_hard = 0;
+  double objective_gap = 0;  // (g(x) − g(x_ref)) / (g(start) − g(x_ref)), lab 06's g at the scene's k
   double energy_drift = 0, energy_drift_rel = 0;
   std::string problem;  // the step or the horizon went wrong (the run's numbers are then partial)
   bool on_front = false;
@@ -157,6 +166,13 @@ struct SceneInfo {
   double hard_displacement = 0.0;  // RMS of the hard step's displacement, m (0: no hard step)
   double reference_constrained_gradient = 0.0, reference_gradient = 0.0;
   Spread spread;       // the second route's end against the reference step
+  // At the shared start (bench/step_residual.h): the runs' residuals are over these.
+  double start_residual = 0.0;                                  // m
+  double start_hard_violation = 0.0, start_hard_stationarity = 0.0, start_hard_residual = 0.0;  // m
+  double objective_drop = 0.0;  // g(start) − g(x_ref), J
+  // The targets' own residuals over the start's: the reference step's (k step)
+  // and the k = 1e9 N/m hard step's against the true hard step's (NaN: none).
+  double reference_residual = 0.0, hard_step_residual = std::numeric_limits<double>::quiet_NaN();
   Spread hard_spread;  // and against the hard step (NaN when there is none)
 };
 
@@ -569,6 +585,7 @@ int run(const Options& options) {
   Progress progress;
   std::vector<Run> runs;
   std::vector<SceneInfo> infos;
+  double residual_seconds = 0.0;  // the runs' residuals and gaps (the summary says what they cost)
 
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const cl::Scene scene = make_scene(scenes[s], options.stiffness);
@@ -641,6 +658,26 @@ int run(const Options& options) {
       progress.clear();
       print_spread(scene.name, info.hard_spread, "the hard step");
     }
+    // The residuals' and the objective gap's scales: their values at the
+    // shared start, where every method begins (relative_residual = 1 there).
+    info.start_residual = cl::bench::step_residual(k_problem, start.x, y);
+    cl::SpdFactorization delassus;  // the hard residuals' J M⁻¹ Jᵀ: one pattern per scene
+    const cl::bench::HardResidual start_hard = cl::bench::hard_residual(k_problem, start.x, y, &delassus);
+    info.start_hard_violation = start_hard.violation;
+    info.start_hard_stationarity = start_hard.stationarity;
+    info.start_hard_residual = start_hard.norm();
+    const double reference_objective = cl::lab06::objective(k_problem, converged.x, y);
+    info.objective_drop = cl::lab06::objective(k_problem, start.x, y) - reference_objective;
+    info.reference_residual = cl::bench::step_residual(k_problem, converged.x, y) / info.start_residual;
+    if (info.hard_displacement > 0.0) {
+      const cl::bench::HardResidual at_hard = cl::bench::hard_residual(k_problem, hard.x, y, &delassus);
+      info.hard_step_residual = at_hard.norm() / info.start_hard_residual;
+    }
+    std::printf("%-12s at the start: step residual %.2e m, hard step's violation %.2e m and stationarity %.2e m; "
+                "g(start) - g(reference) %.3e J; relative residuals of the reference %.1e, of the hard step %.1e\n",
+                scene.name.c_str(), info.start_residual, info.start_hard_violation, info.start_hard_stationarity,
+                info.objective_drop, info.reference_residual, info.hard_step_residual);
+    std::fflush(stdout);
     infos.push_back(info);
 
     const std::size_t first_run = runs.size();
@@ -692,6 +729,17 @@ int run(const Options& options) {
         r.relative_distance_hard = info.hard_displacement > 0.0
                                        ? rms_distance(one.x, hard.x) / info.hard_displacement
                                        : std::numeric_limits<double>::quiet_NaN();
+        // Residuals (bench/step_residual.h) over the start's, every run both:
+        // each family is judged by its own, as by its own distance.
+        const cl::Timer residual_timer;
+        r.residual_rms = cl::bench::step_residual(k_problem, one.x, y);
+        r.relative_residual = r.residual_rms / info.start_residual;
+        const cl::bench::HardResidual hard_residual = cl::bench::hard_residual(k_problem, one.x, y, &delassus);
+        r.hard_violation_rms = hard_residual.violation;
+        r.hard_stationarity_rms = hard_residual.stationarity;
+        r.relative_residual_hard = hard_residual.norm() / info.start_hard_residual;
+        r.objective_gap = (cl::lab06::objective(k_problem, one.x, y) - reference_objective) / info.objective_drop;
+        residual_seconds += residual_timer.seconds();
 
         // The horizon: `horizon` steps from the shared start with one solver.
         if (r.problem.empty()) {
@@ -732,8 +780,9 @@ int run(const Options& options) {
   // ---------------------------------------------------------------- output
   cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
                       "step_seconds", "seconds_per_iteration", "repeats", "setup_seconds", "max_strain", "rms_strain",
-                      "distance_rms", "distance_max", "relative_distance", "relative_distance_hard", "horizon_steps", "energy_drift",
-                      "energy_drift_rel", "on_front", "problem"});
+                      "distance_rms", "distance_max", "relative_distance", "relative_distance_hard", "residual_rms",
+                      "relative_residual", "hard_violation_rms", "hard_stationarity_rms", "relative_residual_hard",
+                      "objective_gap", "horizon_steps", "energy_drift", "energy_drift_rel", "on_front", "problem"});
   auto info_of = [&](const std::string& name) -> const SceneInfo& {
     return *std::find_if(infos.begin(), infos.end(), [&](const SceneInfo& i) { return i.name == name; });
   };
@@ -744,7 +793,9 @@ int run(const Options& options) {
                    method.lab, r.linear_solver, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
                    r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
                    r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance, r.relative_distance_hard,
-                   static_cast<long long>(r.horizon_steps), r.energy_drift, r.energy_drift_rel,
+                   r.residual_rms, r.relative_residual, r.hard_violation_rms, r.hard_stationarity_rms,
+                   r.relative_residual_hard, r.objective_gap, static_cast<long long>(r.horizon_steps), r.energy_drift,
+                   r.energy_drift_rel,
                    static_cast<long long>(r.on_front ? 1 : 0), csv_text(r.problem)});
   }
   table.write(cl::join_path(options.out, "trade.csv"));
@@ -756,7 +807,9 @@ int run(const Options& options) {
                             "hard_seconds", "hard_displacement_rms", "hard_newton_iterations",
                             "hard_gradient_norm", "second_route_iterations", "second_route_gradient_norm",
                             "second_route_seconds", "reference_spread", "hard_second_route_iterations",
-                            "hard_second_route_gradient_norm", "hard_second_route_seconds", "hard_spread"});
+                            "hard_second_route_gradient_norm", "hard_second_route_seconds", "hard_spread",
+                            "start_residual", "start_hard_violation", "start_hard_stationarity", "objective_drop",
+                            "reference_relative_residual", "hard_relative_residual_hard"});
   for (const SceneInfo& info : infos) {
     scene_table.add_row({info.name, info.particles, info.springs, options.stiffness, 1.0 / 60.0,
                          static_cast<long long>(warmup), static_cast<long long>(info.reference_constrained_iterations),
@@ -768,7 +821,9 @@ int run(const Options& options) {
                          static_cast<long long>(info.hard_newton_iterations), info.hard_gradient,
                          static_cast<long long>(info.spread.iterations), info.spread.gradient_norm, info.spread.seconds,
                          info.spread.relative, static_cast<long long>(info.hard_spread.iterations),
-                         info.hard_spread.gradient_norm, info.hard_spread.seconds, info.hard_spread.relative});
+                         info.hard_spread.gradient_norm, info.hard_spread.seconds, info.hard_spread.relative,
+                         info.start_residual, info.start_hard_violation, info.start_hard_stationarity,
+                         info.objective_drop, info.reference_residual, info.hard_step_residual});
   }
   scene_table.write(cl::join_path(options.out, "trade_scenes.csv"));
 
@@ -778,27 +833,40 @@ int run(const Options& options) {
   // and of the distance to the hard step (the hard family's own target; NaN,
   // never a winner, when the scene has none). A distance target below its
   // step's spread (two minimisers farther apart than it) is unresolved:
-  // method "unresolved", no winner.
-  const std::vector<double> targets{1e-2, 1e-3};
-  constexpr int kMeasures = 3;
-  const char* const measures[kMeasures] = {"max_strain", "relative_distance", "relative_distance_hard"};
+  // method "unresolved", no winner. The residuals of the k step and of the
+  // hard step, over the start's, are 0 at every solution alike: never
+  // unresolved, and their targets are 1e-3 and 1e-6.
+  constexpr int kMeasures = 5;
+  constexpr std::size_t kTargets = 2;
+  const char* const measures[kMeasures] = {"max_strain", "relative_distance", "relative_distance_hard",
+                                           "relative_residual", "relative_residual_hard"};
+  auto targets_of = [](int measure) {
+    return measure >= 3 ? std::array<double, kTargets>{1e-3, 1e-6} : std::array<double, kTargets>{1e-2, 1e-3};
+  };
   auto value_of = [](const Run& r, int measure) {
-    return measure == 0 ? r.max_strain : measure == 1 ? r.relative_distance : r.relative_distance_hard;
+    switch (measure) {
+      case 0: return r.max_strain;
+      case 1: return r.relative_distance;
+      case 2: return r.relative_distance_hard;
+      case 3: return r.relative_residual;
+      default: return r.relative_residual_hard;
+    }
   };
   cl::CsvTable fastest({"scene", "measure", "target", "method", "iterations", "step_seconds", "value"});
   // best[measure][scene][target]
   std::vector<std::vector<std::vector<const Run*>>> best(
-      kMeasures, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(targets.size(), nullptr)));
+      kMeasures, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(kTargets, nullptr)));
   auto spread_of = [&](int measure, std::size_t scene) {
     return measure == 1 ? infos[scene].spread.relative
                         : measure == 2 ? infos[scene].hard_spread.relative : std::numeric_limits<double>::quiet_NaN();
   };
   auto unresolved = [&](int measure, std::size_t scene, std::size_t target) {
-    return spread_of(measure, scene) > targets[target];
+    return spread_of(measure, scene) > targets_of(measure)[target];
   };
   for (int m = 0; m < kMeasures; ++m) {
+    const std::array<double, kTargets> targets = targets_of(m);
     for (std::size_t s = 0; s < infos.size(); ++s) {
-      for (std::size_t t = 0; t < targets.size(); ++t) {
+      for (std::size_t t = 0; t < kTargets; ++t) {
         const Run*& b = best[static_cast<std::size_t>(m)][s][t];
         if (unresolved(m, s, t)) {
           fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], std::string("unresolved"), 0LL, 0.0,
@@ -851,16 +919,25 @@ int run(const Options& options) {
   scaling.write(cl::join_path(options.out, "trade_scaling.csv"));
 
   // ---------------------------------------------------------------- summary
-  std::printf("\ntrade: %zu runs on %zu scenes in %.0f s; CSV in %s\n", runs.size(), infos.size(), total.seconds(),
-              options.out.c_str());
+  std::printf("\ntrade: %zu runs on %zu scenes in %.0f s (of which the runs' residuals %.1f s); CSV in %s\n",
+              runs.size(), infos.size(), total.seconds(), residual_seconds, options.out.c_str());
   const char* const titles[kMeasures] = {"max strain error", "distance to the reference step / step displacement",
-                                         "distance to the hard step (k = 1e9 N/m) / its displacement"};
+                                         "distance to the hard step (k = 1e9 N/m) / its displacement",
+                                         "the step's residual / the start's",
+                                         "the hard step's residual / the start's"};
   for (int m = 0; m < kMeasures; ++m) {
-    std::printf("fastest method to %s <= 1e-2 and <= 1e-3 (median wall time per step):\n", titles[m]);
-    std::printf("  %-12s %-30s %-30s\n", "scene", "<= 1e-2", "<= 1e-3");
+    const std::array<double, kTargets> targets = targets_of(m);
+    auto bound = [](double target) {  // "<= 1e-3", not "<= 1e-03"
+      std::string text = format("<= %.0e", target);
+      const std::size_t zero = text.find("e-0");
+      return zero == std::string::npos ? text : text.erase(zero + 2, 1);
+    };
+    const std::string low = bound(targets[0]), high = bound(targets[1]);
+    std::printf("fastest method to %s %s and %s (median wall time per step):\n", titles[m], low.c_str(), high.c_str());
+    std::printf("  %-12s %-30s %-30s\n", "scene", low.c_str(), high.c_str());
     for (std::size_t s = 0; s < infos.size(); ++s) {
-      std::string cells[2];
-      for (std::size_t t = 0; t < targets.size(); ++t) {
+      std::string cells[kTargets];
+      for (std::size_t t = 0; t < kTargets; ++t) {
         const Run* b = best[static_cast<std::size_t>(m)][s][t];
         if (unresolved(m, s, t)) {
           cells[t] = "unresolved (spread " + format("%.1e", spread_of(m, s)) + ")";

@@ -3,9 +3,12 @@
 step for every method and iteration count, the Pareto front highlighted. Top
 row: max strain error; middle row: distance to the converged reference step,
 relative to the step's displacement; bottom row (when trade.csv has it): the
-same for the hard step, the hard family's own target. Where a scene's step has
-two minimisers (trade_scenes.csv's reference_spread and hard_spread), the
-distances below their spread are shaded: unresolved. Reads
+same for the hard step, the hard family's own target; then (when trade.csv has
+them) the step's residual and the hard step's, each over the shared start's,
+with their targets 1e-3 and 1e-6 (a residual is 0 at every solution alike, so
+it resolves every scene). Where a scene's step has two minimisers
+(trade_scenes.csv's reference_spread and hard_spread), the distances below
+their spread are shaded: unresolved. Reads
 OUTDIR/bench/trade.csv and trade_scenes.csv, writes OUTDIR/bench/pareto.png."""
 import math
 from pathlib import Path
@@ -47,15 +50,18 @@ def main(out_dir):
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
     colors = {m: plt.cm.tab20(i % 20) for i, m in enumerate(methods)}
-    measures = [("max_strain", "max strain error"),
-                ("relative_distance", "distance to reference step\n/ step displacement")]
-    if rows and "relative_distance_hard" in rows[0]:
-        measures.append(("relative_distance_hard", "distance to hard step\n/ its displacement"))
+    distance_levels, residual_levels = (1e-2, 1e-3), (1e-3, 1e-6)
+    measures = [("max_strain", "max strain error", distance_levels),
+                ("relative_distance", "distance to reference step\n/ step displacement", distance_levels)]
+    optional = [("relative_distance_hard", "distance to hard step\n/ its displacement", distance_levels),
+                ("relative_residual", "step residual Δt²‖∇g‖_M⁻¹\n/ the start's", residual_levels),
+                ("relative_residual_hard", "hard step residual\n/ the start's", residual_levels)]
+    measures += [m for m in optional if rows and m[0] in rows[0]]
     figure, axes = plt.subplots(len(measures), len(scenes), figsize=(3.9 * len(scenes), 3.8 * len(measures)),
                                 squeeze=False)
     for column, scene in enumerate(scenes):
         mine = [r for r in rows if r["scene"] == scene]
-        for row, (key, label) in enumerate(measures):
+        for row, (key, label, levels) in enumerate(measures):
             ax = axes[row][column]
             for method in methods:
                 runs = sorted((r for r in mine if r["method"] == method and math.isfinite(float(r[key]))),
@@ -72,7 +78,7 @@ def main(out_dir):
                     zorder=0, label="Pareto front")
             ax.scatter([p[0] for p in best], [p[1] for p in best], s=70, facecolors="none", edgecolors="black",
                        linewidths=1.2, zorder=5)
-            for level in (1e-2, 1e-3):
+            for level in levels:
                 ax.axhline(level, color="gray", linestyle=":", linewidth=0.8)
             if (key, scene) in spread:
                 level = spread[(key, scene)]

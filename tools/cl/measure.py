@@ -1,5 +1,7 @@
 """./course bench and ./course extremes: the measurements (bench/), and their CI check."""
 import argparse
+import csv
+import math
 import shlex
 import subprocess
 import sys
@@ -91,7 +93,46 @@ def check_measurements(checks, out):
             continue
         checks.record(code == 0, f"{program} --quick: {lines[-1] if lines else 'no output'}",
                       [] if code == 0 else lines[-20:])
+        if program == "trade" and code == 0:
+            check_trade_accuracy(checks, out / "bench" / "trade.csv")
     check_micro(checks)
+
+
+# The accuracy columns every run of trade.csv must have, finite (bench/README.md):
+# a residual or a gap that is NaN or missing would leave the run out of the
+# fastest tables without a word.
+TRADE_ACCURACY_COLUMNS = ("residual_rms", "relative_residual", "hard_violation_rms", "hard_stationarity_rms",
+                          "relative_residual_hard", "objective_gap")
+
+
+def check_trade_accuracy(checks, table):
+    """CI: every run of the quick trade has the residuals and the objective gap, finite."""
+    try:
+        with open(table, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as error:
+        checks.record(False, f"trade --quick: {table} unreadable: {error}")
+        return
+    missing = [c for c in TRADE_ACCURACY_COLUMNS if not rows or c not in rows[0]]
+    bad = []
+    for number, row in enumerate(rows, start=2):
+        for column in TRADE_ACCURACY_COLUMNS:
+            if column in missing:
+                continue
+            try:
+                value = float(row[column])
+            except ValueError:
+                value = math.nan
+            if not math.isfinite(value):
+                bad.append(f"{table.name} line {number} ({row['scene']} {row['method']} K={row['iterations']}): "
+                           f"{column} = {row[column]!r}")
+    ok = bool(rows) and not missing and not bad
+    summary = f"trade --quick: {len(rows)} runs, each with {', '.join(TRADE_ACCURACY_COLUMNS)} finite"
+    if missing:
+        summary += f" (missing: {', '.join(missing)})"
+    if bad:
+        summary += f" ({len(bad)} not finite)"
+    checks.record(ok, summary, bad[:20])
 
 
 def check_micro(checks):
