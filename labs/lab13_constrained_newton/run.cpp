@@ -155,10 +155,10 @@ int run_scene(const char* lab_name, const std::string& scene_dir, const CommonOp
     print_stopped(result.step_failed ? "STOPPED" : "DIVERGED", "step", result.problem_step, scene.dt, result.problem);
   }
   std::printf("  max strain %.3e; %lld iterations (%.2f per step), %d backtracks, %d failed decreases, "
-              "%d fallbacks to dropped compression, %d exact rescues, %d steps not converged\n",
+              "%d fallbacks (descent steps on g past a fold), %d refused factorizations, %d steps not converged\n",
               strain.max, result.iterations_done,
               result.steps_done ? static_cast<double>(result.iterations_done) / result.steps_done : 0.0,
-              result.backtracks, result.failed_decreases, result.fallbacks, result.exact_rescues,
+              result.backtracks, result.failed_decreases, result.fallbacks, result.refused_factorizations,
               result.unconverged_steps);
   print_time(result.seconds, result.steps_done, "step", static_cast<double>(result.iterations_done), "iteration");
   std::printf("\n");
@@ -177,6 +177,7 @@ int run_scene(const char* lab_name, const std::string& scene_dir, const CommonOp
     summary.extra["failed_decreases"] = result.failed_decreases;
     summary.extra["fallbacks"] = result.fallbacks;
     summary.extra["exact_rescues"] = result.exact_rescues;
+    summary.extra["refused_factorizations"] = result.refused_factorizations;
     summary.extra["unconverged_steps"] = result.unconverged_steps;
     summary.extra["iterations_per_step"] = iterations;
     summary.extra["force_error_per_step"] = force_errors;
