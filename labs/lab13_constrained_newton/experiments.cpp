@@ -19,8 +19,10 @@ double parse_stiffness(const std::string& flag, const std::string& text) {
   if (text == "inf") return std::numeric_limits<double>::infinity();
   std::size_t used = 0;
   double k = 0.0;
+  // Decimal only: std::stod also reads hexadecimal ("0x10" would be 16 N/m).
+  const bool decimal = text.find_first_not_of("0123456789.eE+-") == std::string::npos;
   try {
-    k = std::stod(text, &used);
+    if (decimal) k = std::stod(text, &used);
   } catch (const std::exception&) {
     used = 0;
   }
@@ -64,9 +66,18 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
   std::vector<double> stiffnesses;
   for (const std::string& text : lab.stiffnesses) stiffnesses.push_back(parse_stiffness("--stiffnesses", text));
   std::vector<Start> starts;
-  for (const std::string& s : lab.starts) starts.push_back(start_from_name(s));
+  // The flag's name in the refusal (start_from_name says only what it knows).
+  try {
+    for (const std::string& s : lab.starts) starts.push_back(start_from_name(s));
+  } catch (const std::invalid_argument& error) {
+    throw InputError(std::string("--starts: ") + error.what());
+  }
   std::vector<Warm> warms;
-  for (const std::string& w : lab.warms) warms.push_back(warm_from_name(w));
+  try {
+    for (const std::string& w : lab.warms) warms.push_back(warm_from_name(w));
+  } catch (const std::invalid_argument& error) {
+    throw InputError(std::string("--warms: ") + error.what());
+  }
   const std::vector<Scene> scenes = load_scenes(options, lab.sweep_scenes, scene_dir);
   if (!options.out.empty()) ensure_directory(options.out);
 

@@ -252,6 +252,13 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
   };
   // A residual or merit that is not finite at the start would reach your
   // sufficient_decrease as ψ(0): the step stops here and says which term.
+  if (!all_finite(y)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the prediction y = x + dt v + dt^2 g is not finite at dt = %.3g s: use a smaller dt (--dt)", dt_);
+    report.problem = text;
+    return report;
+  }
   if (!r.force.allFinite() || !r.constraint.allFinite() || !std::isfinite(psi)) {
     report.problem = !r.force.allFinite()
                          ? "residuals() returned a force residual r_x = M(x - y)/dt^2 - J^T lambda that is not finite "

@@ -40,7 +40,9 @@ int run_live_scene(const char* lab_name, const CommonOptions& options, const Lab
   const bool finite = !scene.springs.empty() && std::isfinite(scene.springs.front().stiffness);
   std::vector<Knob> declared{{"K", "iterations", 1, 100, 1.0 * options.iterations, true},
                              {"dt", "s", 1e-4, 0.05, scene.dt}};
-  if (finite) declared.push_back({"k", "N/m", 1, 1e10, scene.springs.front().stiffness});
+  // k up to 1e8 N/m: the range where every step converges (README.md,
+  // "Where it holds"; at 1e10 a 32² curtain's step stalls at the cap).
+  if (finite) declared.push_back({"k", "N/m", 1, kLiveStiffnessMax, scene.springs.front().stiffness});
   LiveRun run{lab_name, options.method, Knobs(declared)};
   std::vector<Spring> springs = scene.springs;
   Settings settings = lab.settings;
