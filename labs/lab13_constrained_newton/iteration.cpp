@@ -177,6 +177,44 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
   return solution;
 }
 
+std::string Solver::hard_set_problem(const Eigen::Matrix3Xd& x, const std::string& problem) const {
+  if (problem.find("singular") == std::string::npos) return problem;
+  // Say what in the scene makes lab 07's KKT matrix singular: a spring given
+  // twice, a spring whose ends coincide (no direction), or more hard
+  // constraints than the movable coordinates can satisfy independently.
+  std::string what;
+  int hard = 0;
+  for (std::size_t e = 0; e < springs_.size() && what.empty(); ++e) {
+    const Spring& s = springs_[e];
+    const bool is_hard = compliance_.size() == 0 || compliance_[static_cast<Eigen::Index>(e)] == 0.0;
+    if (!is_hard) continue;
+    ++hard;
+    if (!((x.col(s.i) - x.col(s.j)).norm() > 0.0)) {
+      what = "hard spring " + std::to_string(e) + " has coincident ends (particles " + std::to_string(s.i) + " and " +
+             std::to_string(s.j) + "): its constraint has no direction";
+    }
+    for (std::size_t f = 0; f < e && what.empty(); ++f) {
+      const Spring& t = springs_[f];
+      if ((t.i == s.i && t.j == s.j) || (t.i == s.j && t.j == s.i)) {
+        what = "hard springs " + std::to_string(f) + " and " + std::to_string(e) + " join the same particles (" +
+               std::to_string(s.i) + ", " + std::to_string(s.j) + ")";
+      }
+    }
+  }
+  if (what.empty()) {
+    hard = 0;
+    for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(springs_.size()); ++e) {
+      if (compliance_.size() == 0 || compliance_[e] == 0.0) ++hard;
+    }
+    what = "its " + std::to_string(hard) + " hard springs on " + std::to_string(3 * map_.unknowns()) +
+           " movable coordinates are a redundant set (some constraint is implied by others, or a taut set leaves "
+           "no motion)";
+  }
+  return "the hard constraints are redundant or singular here, so the step and its forces are not unique: " + what +
+         ". Give the springs a finite stiffness (--stiffness, e.g. 1e9) or remove the redundant ones (lab 07's "
+         "README.md, redundant constraints). [" + problem + "]";
+}
+
 double Solver::objective(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) const {
   double inertia = 0.0;
   for (const int p : map_.particle_of) inertia += (x.col(p) - y.col(p)).squaredNorm() / inv_mass_[p];
@@ -307,7 +345,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     const auto constraints = static_cast<Eigen::Index>(springs_.size());
     const std::string problem = lab07::solution_problem(solution, unknowns, constraints);
     if (!problem.empty()) {
-      report.problem = where + problem;
+      report.problem = where + (schur ? problem : hard_set_problem(x, problem));
       return report;
     }
     // The safeguard: halve α until the merit falls enough (sufficient_decrease).

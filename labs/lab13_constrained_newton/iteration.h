@@ -143,6 +143,9 @@ class Solver {
   lab07::StepSolution schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
                                   const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
                                   lab09::Compression compression, Eigen::VectorXd& rhs) const;
+  // A KKT solve's problem that says "singular", in the scene's words: which
+  // hard springs (a duplicate, coincident ends) or the count, and what to do.
+  std::string hard_set_problem(const Eigen::Matrix3Xd& x, const std::string& problem) const;
   // g(x) = ½ (x − y)ᵀM(x − y)/Δt² + Σ ½ k_e φ_e², lab 06's objective (every c_e > 0), J.
   double objective(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) const;
   // The fallback's search: x + αΔx for α = 1, ½, … (at most 2·max_backtracks
