@@ -232,16 +232,16 @@ bool Solver::descend_on_g(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, 
                           int& backtracks) const {
   if (!(slope < 0.0)) return false;
   const double before = objective(x, y);
-  // At g's round-off (a predicted decrease of a few ulps of g) no
-  // comparison of g can be trusted: the full step is taken, and the
-  // constrained iteration that follows judges it by ψ.
-  const bool round_off = -slope <= 64.0 * std::numeric_limits<double>::epsilon() * std::abs(before);
+  // At g's round-off (a predicted decrease of a few ulps of g) g cannot
+  // judge a step, and the iterate is as good as g can tell: no fallback (ψ,
+  // which does not lose the springs' forces to round-off as g's gradient
+  // does at large k, has the last word, and the step stops there).
+  if (-slope <= 64.0 * std::numeric_limits<double>::epsilon() * std::abs(before)) return false;
   for (alpha = 1.0;; alpha *= 0.5) {
     trial = x;
     for (int u = 0; u < map_.unknowns(); ++u) {
       trial.col(map_.particle_of[static_cast<std::size_t>(u)]) += alpha * dx.segment<3>(3 * u);
     }
-    if (round_off) return true;
     const double after = objective(trial, y);
     if (std::isfinite(after) && after <= before + kArmijo * alpha * slope) return true;
     if (backtracks == 2 * max_backtracks) return false;
