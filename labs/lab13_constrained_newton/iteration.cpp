@@ -149,12 +149,23 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
       const Spring& s = springs_[e];
       ratio = std::max(ratio, dt2 / compliance_[static_cast<Eigen::Index>(e)] * (inv_mass_[s.i] + inv_mass_[s.j]));
     }
+    double lightest = std::numeric_limits<double>::infinity(), heaviest = 0.0;
+    for (const int p : map_.particle_of) {
+      lightest = std::min(lightest, 1.0 / inv_mass_[p]);
+      heaviest = std::max(heaviest, 1.0 / inv_mass_[p]);
+    }
+    char text[240];
     if (compression == lab09::Compression::kDrop && ratio > 1e12) {
-      char text[200];
       std::snprintf(text, sizeof text,
                     " to working precision: at dt = %.3g s, dt^2 k / m reaches %.2g, more than a double resolves; "
                     "use a smaller dt (--dt)",
                     dt_, ratio);
+      solution.problem += text;
+    } else if (compression == lab09::Compression::kDrop && heaviest > 1e12 * lightest) {
+      std::snprintf(text, sizeof text,
+                    " to working precision: the scene's masses span %.2g kg to %.2g kg, more than a double resolves "
+                    "in one matrix; bring them within 1e12 of each other",
+                    lightest, heaviest);
       solution.problem += text;
     }
     return solution;
