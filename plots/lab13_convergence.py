@@ -5,9 +5,9 @@ Reads every OUTDIR/lab13_constrained_newton/**/crossover.csv and the
 convergence.csv beside it (the --convergence lines of
 labs/lab13_constrained_newton/demo.txt) and writes, beside each:
   iterations_vs_k.png       iterations to a relative distance 1e-6 of the
-                            converged step against k, per method (a method that
-                            did not get there within its cap is drawn at the cap
-                            with an open marker)
+                            converged step against finite k, per method (a method
+                            that did not get there within its cap is drawn at the
+                            top with an open marker); none for a hard-only sweep
   convergence_<scene>.png   relative distance against iteration, one panel per k
 Exit 4 when the data are absent.
 """
@@ -27,26 +27,40 @@ def run_label(row):
 
 
 def draw_iterations(crossover, target):
-    figure, axis = plt.subplots(figsize=(7, 4.5))
+    """False when the table has no finite k (a hard-only sweep): no figure."""
     runs = {}
     for row in figures.rows(crossover):
         k = float(row["stiffness"])
         if math.isinf(k):
             continue
         runs.setdefault((row["scene"], run_label(row)), []).append(row)
-    missed = []  # (k, colour) of the runs that did not reach 1e-6, drawn at the top once the axis is set
-    for (scene, name), found in sorted(runs.items()):
+    if not runs:
+        return False
+    figure, axis = plt.subplots(figsize=(9, 4.5))
+    # One colour per run (a colour map with as many as there are runs: the
+    # default cycle has ten), one marker per scene.
+    colours = plt.get_cmap("tab20")
+    scenes = sorted({scene for scene, _ in runs})
+    markers = "osD^v<>"
+    missed = []  # (k, colour, marker) of the runs that did not reach 1e-6, drawn at the top once the axis is set
+    for index, ((scene, name), found) in enumerate(sorted(runs.items())):
         ks = [float(r["stiffness"]) for r in found]
         counts = [int(r["iterations_1e-6"]) if r["iterations_1e-6"] else math.nan for r in found]
-        line, = axis.loglog(ks, counts, "-o", markersize=4, label=f"{scene}: {name}")
-        missed += [(k, line.get_color()) for k, c in zip(ks, counts) if math.isnan(c)]
+        colour = colours(index % 20)
+        marker = markers[scenes.index(scene) % len(markers)]
+        axis.semilogx(ks, counts, "-", marker=marker, markersize=4, color=colour, label=f"{scene}: {name}")
+        missed += [(k, colour, marker) for k, c in zip(ks, counts) if math.isnan(c)]
+    axis.set_ylim(bottom=0)
     top = axis.get_ylim()[1]
-    for k, colour in missed:
-        axis.loglog([k], [top], "o", markerfacecolor="none", color=colour, clip_on=False)
-    figures.finish(axis, "spring stiffness k (N/m)", "iterations to a relative distance 1e-6 (1)")
+    for k, colour, marker in missed:
+        axis.semilogx([k], [top], marker, markerfacecolor="none", color=colour, clip_on=False)
+    figures.finish(axis, "spring stiffness k (N/m)", "iterations to a relative distance 1e-6 (1)", legend=None)
+    # The legend beside the axes, where it covers no data.
+    axis.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
     axis.set_title("Lab 13: iterations to the implicit step against k (open: not reached)")
     figure.tight_layout()
     figures.save(figure, target, dpi=120)
+    return True
 
 
 def draw_curves(convergence, scene, target):
@@ -82,7 +96,7 @@ def main(out_dir):
         sources = [crossover] + ([convergence] if convergence.is_file() else [])
         target = crossover.with_name("iterations_vs_k.png")
         if not figures.up_to_date(target, sources):
-            draw_iterations(crossover, target)
+            draw_iterations(crossover, target)  # nothing for a hard-only sweep (k = inf has no place on the axis)
         if not convergence.is_file():
             continue
         for scene in sorted({r["scene"] for r in figures.rows(crossover)}):

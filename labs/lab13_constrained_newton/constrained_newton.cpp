@@ -22,8 +22,9 @@ Residuals residuals(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
 }
 
 // TODO(lab13.2) [7 pts] v̂ = (y − x)/Δt − Δt g for every unknown, stacked.
-// Graded by tests/lab13_constrained_newton/test_first_iteration.cpp (the first
-// iteration is lab 09's step) and test_rebased.cpp.
+// Graded by tests/lab13_constrained_newton/test_rebased.cpp (at the start
+// it is the velocity; the first iteration is lab 09's step; at any iterate
+// lab 09's system is the Newton system).
 Eigen::VectorXd rebased_velocity(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const MovableMap& map,
                                  const Eigen::Vector3d& gravity, double dt) {
   (void)x, (void)y, (void)map, (void)gravity, (void)dt;
@@ -40,9 +41,10 @@ Eigen::VectorXd warm_start(const Eigen::Matrix3Xd& x, const std::vector<Spring>&
   not_implemented("warm_start", __FILE__);
 }
 
-// TODO(lab13.4) [4 pts] force_error = ‖force‖∞ / max(‖inertia‖∞,
+// TODO(lab13.4) [5 pts] force_error = ‖force‖∞ / max(‖inertia‖∞,
 // ‖constraint_force‖∞) (0 when ‖force‖∞ = 0), constraint_error =
-// ‖constraint‖∞ / length_scale, converged when both ≤ tolerance.
+// ‖constraint‖∞ / length_scale, converged when both ≤ tolerance. A NaN or
+// infinite residual gives an error that is not finite: never converged.
 // Graded by tests/lab13_constrained_newton/test_convergence.cpp.
 Convergence convergence(const Residuals& residuals, double length_scale, double tolerance) {
   (void)residuals, (void)length_scale, (void)tolerance;

@@ -98,6 +98,9 @@ struct Convergence {
   // manifold, max |φ_e|, in units of the length scale.
   double constraint_error = 0.0;
   bool converged = false;  // both ≤ tolerance
+  // A residual with a NaN or infinite entry gives a force or constraint error
+  // that is not finite, and is never converged (NaN ≤ tolerance is false: no
+  // guard may turn it into 0 on the way).
 };
 
 // TODO(lab13.4) — the convergence test above. length_scale (m, > 0): the

@@ -24,6 +24,8 @@ double parse_stiffness(const std::string& flag, const std::string& text) {
   } catch (const std::exception&) {
     used = 0;
   }
+  // Decimal only: std::stod also reads hexadecimal ("0x10" would be 16 N/m).
+  if (text.find_first_not_of("0123456789.eE+-") != std::string::npos) used = 0;
   if (used != text.size() || !std::isfinite(k) || !(k > 0.0)) {
     throw InputError(flag + ": '" + text + "' is not a stiffness (a finite number > 0 in N/m, or inf)");
   }
@@ -37,6 +39,21 @@ void set_stiffness(Scene& scene, double k) {
 namespace {
 
 constexpr double kTargets[] = {1e-2, 1e-3, 1e-6};  // relative distances to x*
+
+// A list flag's names, each converted by from_name; a refusal names the flag.
+template <typename T>
+std::vector<T> from_names(const std::string& flag, const std::vector<std::string>& names,
+                          T (*from_name)(const std::string&)) {
+  std::vector<T> values;
+  for (const std::string& name : names) {
+    try {
+      values.push_back(from_name(name));
+    } catch (const std::invalid_argument& error) {
+      throw InputError(flag + ": " + error.what());
+    }
+  }
+  return values;
+}
 
 // rms_p ‖a_p − b_p‖ over the movable particles.
 double rms_difference(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b, const MovableMap& map) {
@@ -63,10 +80,8 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
                    "--convergence writes CSV files, not a run summary");
   std::vector<double> stiffnesses;
   for (const std::string& text : lab.stiffnesses) stiffnesses.push_back(parse_stiffness("--stiffnesses", text));
-  std::vector<Start> starts;
-  for (const std::string& s : lab.starts) starts.push_back(start_from_name(s));
-  std::vector<Warm> warms;
-  for (const std::string& w : lab.warms) warms.push_back(warm_from_name(w));
+  const std::vector<Start> starts = from_names("--starts", lab.starts, start_from_name);
+  const std::vector<Warm> warms = from_names("--warms", lab.warms, warm_from_name);
   const std::vector<Scene> scenes = load_scenes(options, lab.sweep_scenes, scene_dir);
   start_run(options);
 
@@ -88,6 +103,10 @@ int run_convergence(const char* lab_name, const std::string& scene_dir, const Co
       warmup.gravity = scene.gravity;
       warmup.iterations = 50;
       warmup.tolerance = 1e-10;
+      // The start and x* are the exact iteration's whatever --compression
+      // says, so that drop's rows are measured against the same converged x*
+      // as keep's (drop's own stops short of round-off, its slow tail).
+      warmup.compression = lab09::Compression::kKeep;
       std::string problem;
       for (int s = 0; s < lab.warmup && problem.empty(); ++s) problem = warm_solver.step(start, warmup).problem;
       const std::string k_text = format_double(k);

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -93,7 +95,7 @@ StepReport Solver::step(Particles& particles, const Settings& settings, const It
 
 lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
                                        const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
-                                       lab09::Compression compression) const {
+                                       lab09::Compression compression, Eigen::VectorXd& rhs) const {
   // Lab 09's eliminated system (geometric_stiffness.h) at x, per spring e
   // with n = (x_i − x_j)/ℓ and s = 1/c_e: the mass on the diagonal, and the block
   //     Δt² [ s n nᵀ − (λ_e/ℓ)(I − n nᵀ) ]       (Δt² Jᵀ C⁻¹ J − Δt² K_g)
@@ -104,7 +106,7 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
   const std::size_t m = springs_.size();
   Eigen::Matrix3Xd units(3, static_cast<Eigen::Index>(m));
   Eigen::VectorXd phi(static_cast<Eigen::Index>(m));
-  Eigen::VectorXd rhs(3 * map_.unknowns());
+  rhs.resize(3 * map_.unknowns());
   eliminated_.set_zero();
   for (int u = 0; u < map_.unknowns(); ++u) {
     const double w = inv_mass_[map_.particle_of[static_cast<std::size_t>(u)]];
@@ -139,6 +141,33 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
   lab07::StepSolution solution;
   if (!factor_.refactor(eliminated_.matrix())) {
     solution.problem = "the eliminated matrix M - dt^2 K_g + dt^2 J^T C^-1 J is not positive definite";
+    // With springs dropped from K_g it is M plus a positive semidefinite
+    // matrix: only round-off refuses it, when Δt² k outweighs a mass by more
+    // than a double resolves. Say so in terms of Δt.
+    double ratio = 0.0;
+    for (std::size_t e = 0; e < m; ++e) {
+      const Spring& s = springs_[e];
+      ratio = std::max(ratio, dt2 / compliance_[static_cast<Eigen::Index>(e)] * (inv_mass_[s.i] + inv_mass_[s.j]));
+    }
+    double lightest = std::numeric_limits<double>::infinity(), heaviest = 0.0;
+    for (const int p : map_.particle_of) {
+      lightest = std::min(lightest, 1.0 / inv_mass_[p]);
+      heaviest = std::max(heaviest, 1.0 / inv_mass_[p]);
+    }
+    char text[240];
+    if (compression == lab09::Compression::kDrop && ratio > 1e12) {
+      std::snprintf(text, sizeof text,
+                    " to working precision: at dt = %.3g s, dt^2 k / m reaches %.2g, more than a double resolves; "
+                    "use a smaller dt (--dt)",
+                    dt_, ratio);
+      solution.problem += text;
+    } else if (compression == lab09::Compression::kDrop && heaviest > 1e12 * lightest) {
+      std::snprintf(text, sizeof text,
+                    " to working precision: the scene's masses span %.2g kg to %.2g kg, more than a double resolves "
+                    "in one matrix; bring them within 1e12 of each other",
+                    lightest, heaviest);
+      solution.problem += text;
+    }
     return solution;
   }
   solution.velocity = factor_.solve(rhs);
@@ -159,6 +188,78 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
   return solution;
 }
 
+std::string Solver::hard_set_problem(const Eigen::Matrix3Xd& x, const std::string& problem) const {
+  if (problem.find("singular") == std::string::npos) return problem;
+  // Say what in the scene makes lab 07's KKT matrix singular: a spring given
+  // twice, a spring whose ends coincide (no direction), or more hard
+  // constraints than the movable coordinates can satisfy independently.
+  std::string what;
+  int hard = 0;
+  for (std::size_t e = 0; e < springs_.size() && what.empty(); ++e) {
+    const Spring& s = springs_[e];
+    const bool is_hard = compliance_.size() == 0 || compliance_[static_cast<Eigen::Index>(e)] == 0.0;
+    if (!is_hard) continue;
+    ++hard;
+    if (!((x.col(s.i) - x.col(s.j)).norm() > 0.0)) {
+      what = "hard spring " + std::to_string(e) + " has coincident ends (particles " + std::to_string(s.i) + " and " +
+             std::to_string(s.j) + "): its constraint has no direction";
+    }
+    for (std::size_t f = 0; f < e && what.empty(); ++f) {
+      const Spring& t = springs_[f];
+      if ((t.i == s.i && t.j == s.j) || (t.i == s.j && t.j == s.i)) {
+        what = "hard springs " + std::to_string(f) + " and " + std::to_string(e) + " join the same particles (" +
+               std::to_string(s.i) + ", " + std::to_string(s.j) + ")";
+      }
+    }
+  }
+  if (what.empty()) {
+    hard = 0;
+    for (Eigen::Index e = 0; e < static_cast<Eigen::Index>(springs_.size()); ++e) {
+      if (compliance_.size() == 0 || compliance_[e] == 0.0) ++hard;
+    }
+    what = "its " + std::to_string(hard) + " hard springs on " + std::to_string(3 * map_.unknowns()) +
+           " movable coordinates are a redundant set (some constraint is implied by others, or a taut set leaves "
+           "no motion)";
+  }
+  return "the hard constraints are redundant or singular here, so the step and its forces are not unique: " + what +
+         ". Give the springs a finite stiffness (--stiffness, e.g. 1e9) or remove the redundant ones (lab 07's "
+         "README.md, redundant constraints). [" + problem + "]";
+}
+
+double Solver::objective(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) const {
+  double inertia = 0.0;
+  for (const int p : map_.particle_of) inertia += (x.col(p) - y.col(p)).squaredNorm() / inv_mass_[p];
+  double elastic = 0.0;
+  for (std::size_t e = 0; e < springs_.size(); ++e) {
+    const Spring& s = springs_[e];
+    const double phi = (x.col(s.i) - x.col(s.j)).norm() - s.rest_length;
+    elastic += phi * phi / compliance_[static_cast<Eigen::Index>(e)];
+  }
+  return 0.5 * inertia / (dt_ * dt_) + 0.5 * elastic;
+}
+
+bool Solver::descend_on_g(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const Eigen::VectorXd& dx,
+                          double slope, int max_backtracks, Eigen::Matrix3Xd& trial, double& alpha,
+                          int& backtracks) const {
+  if (!(slope < 0.0)) return false;
+  const double before = objective(x, y);
+  // At g's round-off (a predicted decrease of a few ulps of g) g cannot
+  // judge a step, and the iterate is as good as g can tell: no fallback (ψ,
+  // which does not lose the springs' forces to round-off as g's gradient
+  // does at large k, has the last word, and the step stops there).
+  if (-slope <= 64.0 * std::numeric_limits<double>::epsilon() * std::abs(before)) return false;
+  for (alpha = 1.0;; alpha *= 0.5) {
+    trial = x;
+    for (int u = 0; u < map_.unknowns(); ++u) {
+      trial.col(map_.particle_of[static_cast<std::size_t>(u)]) += alpha * dx.segment<3>(3 * u);
+    }
+    const double after = objective(trial, y);
+    if (std::isfinite(after) && after <= before + kArmijo * alpha * slope) return true;
+    if (backtracks == 2 * max_backtracks) return false;
+    ++backtracks;
+  }
+}
+
 StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const Eigen::Matrix3Xd& y,
                            const Settings& settings, const IterationCallback& on_iteration) const {
   check(settings);
@@ -177,6 +278,12 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
   linear.method = method;
   const Timer clock;
   double excluded = 0.0;  // time spent only for the records
+  // Compressed springs: kept (the exact matrix) until the Cholesky refuses
+  // it, then dropped for 1, 2, 4, … iterations before the exact matrix is
+  // tried again, so that a buckling cloth pays a refused factorization on a
+  // few iterations of a step, not on every one, and still gets the exact
+  // matrix's quadratic convergence once the step's own matrix is definite.
+  int keep_again = 1, keep_wait = 1;  // the next iteration that tries kKeep; the wait after a refusal
 
   auto evaluate = [&](const Eigen::Matrix3Xd& at, const Eigen::VectorXd& multipliers) {
     return residuals(at, y, multipliers, springs_, inv_mass_, map_, compliance_, dt_);
@@ -192,6 +299,26 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     excluded += timer.seconds();
     return stop;
   };
+  // A residual or merit that is not finite at the start would reach your
+  // sufficient_decrease as ψ(0): the step stops here and says which term.
+  if (!all_finite(y)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "the prediction y = x + dt v + dt^2 g is not finite at dt = %.3g s: use a smaller dt (--dt)", dt_);
+    report.problem = text;
+    return report;
+  }
+  if (!r.force.allFinite() || !r.constraint.allFinite() || !std::isfinite(psi)) {
+    report.problem = !r.force.allFinite()
+                         ? "residuals() returned a force residual r_x = M(x - y)/dt^2 - J^T lambda that is not finite "
+                           "at the step's start (check the inverse masses it divides by, and the scene's masses)"
+                     : !r.constraint.allFinite()
+                         ? "residuals() returned a constraint residual r_lambda = phi + C lambda that is not finite at "
+                           "the step's start"
+                         : "the merit psi is not finite at the step's start (the residuals are): a mass or a "
+                           "stiffness too large for the merit's squares in a double; scale the scene's units";
+    return report;
+  }
   bool stopped = record(0, 0.0, 0);
   Particles at;  // lab 07's linearisation reads positions and inverse masses from a state
   at.inv_mass = inv_mass_;
@@ -208,16 +335,18 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       step.velocity = velocity;
       return step;
     };
-    bool exact = settings.compression == lab09::Compression::kKeep;
     lab07::StepSolution solution;
+    Eigen::VectorXd rhs;  // the Schur right-hand side: −Δt ∇g(x)
+    lab09::Compression compression =
+        k >= keep_again ? settings.compression : lab09::Compression::kDrop;
     if (schur) {
-      solution = schur_solve(x, velocity, lambda, settings.gravity, settings.compression);
-      if (!solution.ok && exact) {
-        // The exact matrix is not definite here (compressed springs): this
-        // iteration drops them, as lab 09's step does (README.md, "Compression").
-        ++report.fallbacks;
-        exact = false;
-        solution = schur_solve(x, velocity, lambda, settings.gravity, lab09::Compression::kDrop);
+      solution = schur_solve(x, velocity, lambda, settings.gravity, compression, rhs);
+      if (!solution.ok && compression == lab09::Compression::kKeep) {
+        ++report.refused_factorizations;
+        keep_again = k + keep_wait;
+        keep_wait *= 2;
+        compression = lab09::Compression::kDrop;
+        solution = schur_solve(x, velocity, lambda, settings.gravity, compression, rhs);
       }
     } else {
       solution = lab09::solve_stiff(linearized(), lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression),
@@ -227,7 +356,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     const auto constraints = static_cast<Eigen::Index>(springs_.size());
     const std::string problem = lab07::solution_problem(solution, unknowns, constraints);
     if (!problem.empty()) {
-      report.problem = where + problem;
+      report.problem = where + (schur ? problem : hard_set_problem(x, problem));
       return report;
     }
     // The safeguard: halve α until the merit falls enough (sufficient_decrease).
@@ -254,6 +383,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       }
     };
     bool accepted = line_search(solution);
+    const bool exact = compression == lab09::Compression::kKeep;
     if (!accepted && !exact && schur && settings.exact_rescue) {
       // Only the exact Newton direction is sure to lower ψ (ψ'(0) = −2ψ): the
       // dropped one found no step length, so this iteration takes lab 07's
@@ -269,6 +399,25 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       }
     }
     report.backtracks += backtracks;
+    if (!accepted && schur) {
+      // The fallback past a fold (README.md, "Past a fold"): ψ found no step
+      // length, but the matrix just factored is positive definite, so Δx
+      // descends on g, lab 06's objective, whose minimiser is the step. A
+      // backtracking search on g along it, then λ re-warmed to the springs'
+      // forces there (warm_start), and the next iteration is the constrained
+      // one again, from a point where its matrix is g's exact Hessian.
+      backtracks = 0;
+      accepted = descend_on_g(x, y, dt_ * solution.velocity, -rhs.dot(solution.velocity), settings.max_backtracks,
+                              trial, alpha, backtracks);
+      report.backtracks += backtracks;
+      if (accepted) {
+        ++report.fallbacks;
+        trial_lambda = warm_start(trial, springs_, lambda, Warm::kForces);
+        trial_r = evaluate(trial, trial_lambda);
+        trial_psi = merit(trial_r, inv_mass_, map_, weights_, dt_);
+        if (!std::isfinite(trial_psi)) accepted = false;
+      }
+    }
     if (!accepted) {
       report.failed_decreases = 1;  // x and λ stay at the last accepted iterate
       break;
@@ -316,6 +465,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
     result.failed_decreases += report.failed_decreases;
     result.fallbacks += report.fallbacks;
     result.exact_rescues += report.exact_rescues;
+    result.refused_factorizations += report.refused_factorizations;
     if (report.problem.empty() && !report.converged && settings.tolerance > 0.0) ++result.unconverged_steps;
     if (report.problem.empty() && on_step) on_step(s, report);
     return StepVerdict{report.problem, report.problem.empty(), report.seconds};
@@ -328,6 +478,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
                         {static_cast<long long>(done.iterations_done), static_cast<long long>(done.converged ? 1 : 0),
                          static_cast<long long>(done.backtracks), static_cast<long long>(done.failed_decreases),
                          static_cast<long long>(done.fallbacks), static_cast<long long>(done.exact_rescues),
+                         static_cast<long long>(done.refused_factorizations),
                          done.force_error, done.constraint_error, done.merit, done.seconds, strain.max, strain.rms,
                          energy},
                         {}};
@@ -347,7 +498,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
 
 std::vector<std::string> step_columns() {
   return {"iterations",       "converged", "backtracks", "failed_decreases", "fallbacks",  "exact_rescues",
-          "force_error",      "constraint_error", "merit", "seconds",  "max_strain", "rms_strain", "total_energy"};
+          "refused_factorizations", "force_error",      "constraint_error", "merit", "seconds",  "max_strain", "rms_strain", "total_energy"};
 }
 
 }  // namespace cl::lab13

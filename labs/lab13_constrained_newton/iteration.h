@@ -36,21 +36,20 @@ struct Settings {
   double tolerance = 1e-8;   // convergence(): both errors ≤ this ends the step (0: run every iteration)
   Start start = Start::kPositions;
   Warm warm = Warm::kForces;
-  // Compressed springs in K_g (README.md, "Compression"): kept where the
-  // matrix stays definite (kKeep, the exact Jacobian: quadratic convergence
-  // near the step; an iteration whose matrix is then refused drops them,
-  // StepReport::fallbacks, and when that direction lowers ψ for no α, takes
-  // lab 07's KKT solve of the exact system, StepReport::exact_rescues), or
-  // always dropped (kDrop: always definite, but a slow linear tail).
+  // Compressed springs in K_g (README.md, "Compression"): kept (kKeep, the
+  // exact Jacobian: quadratic convergence near the step) where the matrix is
+  // definite; after a refusal (StepReport::refused_factorizations) dropped for
+  // 1, 2, 4, … iterations before the exact matrix is tried again; or always
+  // dropped (kDrop: always definite, but a slow linear tail).
   lab09::Compression compression = lab09::Compression::kKeep;
   int max_backtracks = 12;   // halvings of α before the step gives up (α ≥ 2⁻¹²)
-  // A dropped direction (Compression::kDrop, or a fallback) that lowers ψ for
-  // no α: true, the iteration takes lab 07's KKT solve of the exact system
-  // (StepReport::exact_rescues); false, the step stops there (a failed
-  // decrease). The bench's reference step turns it off: on its 128² curtain
-  // the LU costs 15 s an iteration and its damped steps do not get closer.
-  bool exact_rescue = true;
+  // A direction that is not the exact Newton one (dropped compression) and lowers ψ for no α: true, the iteration first tries lab
+  // 07's KKT solve (an LU) of the exact system (StepReport::exact_rescues);
+  // false (the default), it goes straight to the fallback on g (README.md,
+  // "Past a fold"). On a 128² curtain the LU costs 15 s an iteration.
+  bool exact_rescue = false;
 };
+
 
 struct IterationRecord {
   int iteration = 0;          // 0: the first iterate (x⁰, λ⁰)
@@ -70,8 +69,9 @@ struct StepReport {
   bool converged = false;
   int backtracks = 0;          // halvings of α over the step
   int failed_decreases = 0;    // 1 when no α ≥ 2^-max_backtracks decreased ψ: the step stopped there
-  int fallbacks = 0;           // iterations whose exact matrix was refused (kKeep: not definite) and dropped compression
-  int exact_rescues = 0;       // iterations whose dropped direction lowered ψ for no α and took the exact KKT solve
+  int fallbacks = 0;           // iterations whose direction lowered ψ for no α and took a descent step on g
+  int exact_rescues = 0;       // iterations that took lab 07's KKT solve instead (Settings::exact_rescue)
+  int refused_factorizations = 0;  // exact matrices the Cholesky refused (that iteration then drops compression)
   double force_error = 0.0, constraint_error = 0.0, merit = 0.0;  // at the result
   double seconds = 0.0;
   std::string linear_solver;   // "schur" (every c_e > 0: lab 09's primal solve) or "kkt" (some c_e = 0)
@@ -139,9 +139,20 @@ class Solver {
   // eliminated matrix and right-hand side of lab09::eliminated_system,
   // assembled per spring into eliminated_, then v_new and
   // λ = −C⁻¹(φ + Δt J v_new) as solve_stiff_schur gives them.
+  // rhs: the right-hand side, −Δt ∇g(x).
   lab07::StepSolution schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
                                   const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
-                                  lab09::Compression compression) const;
+                                  lab09::Compression compression, Eigen::VectorXd& rhs) const;
+  // A KKT solve's problem that says "singular", in the scene's words: which
+  // hard springs (a duplicate, coincident ends) or the count, and what to do.
+  std::string hard_set_problem(const Eigen::Matrix3Xd& x, const std::string& problem) const;
+  // g(x) = ½ (x − y)ᵀM(x − y)/Δt² + Σ ½ k_e φ_e², lab 06's objective (every c_e > 0), J.
+  double objective(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y) const;
+  // The fallback's search: x + αΔx for α = 1, ½, … (at most 2·max_backtracks
+  // halvings) until Armijo's rule on g with `slope` = ∇g·Δx < 0; false when
+  // none is accepted (or the slope is not negative).
+  bool descend_on_g(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const Eigen::VectorXd& dx, double slope,
+                    int max_backtracks, Eigen::Matrix3Xd& trial, double& alpha, int& backtracks) const;
 };
 
 // ------------------------------------------------------------------ a run
@@ -153,6 +164,7 @@ struct RunResult {
   int failed_decreases = 0;
   int fallbacks = 0;
   int exact_rescues = 0;
+  int refused_factorizations = 0;
   int unconverged_steps = 0;  // steps that ended at the iteration cap or a failed decrease
   double seconds = 0.0;
   double energy_start = 0.0, energy_end = 0.0;
@@ -173,7 +185,7 @@ RunResult run_steps(Particles& particles, Solver& solver, const Settings& settin
                     const RunIterationCallback& on_iteration = nullptr, const FrameOutput& output = {},
                     const RunStepCallback& on_step = nullptr);
 
-// iterations, converged, backtracks, failed_decreases, fallbacks, exact_rescues, force_error,
+// iterations, converged, backtracks, failed_decreases, fallbacks, exact_rescues, refused_factorizations, force_error,
 // constraint_error, merit, seconds, max_strain, rms_strain, total_energy.
 std::vector<std::string> step_columns();
 

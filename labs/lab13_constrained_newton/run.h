@@ -12,6 +12,10 @@
 
 namespace cl::lab13 {
 
+// The live knob k's top (N/m): the stiffness up to which constrained Newton
+// converges every step of the curtains (a test holds it: test_step.cpp).
+inline constexpr double kLiveStiffnessMax = 1e8;
+
 // Runs --scene (with --stiffness; lab 06's methods refuse hard springs) by
 // --method for its steps, or with live.on until the page or a signal stops it:
 // knobs K (iterations), dt and k (every spring's stiffness, N/m; none when

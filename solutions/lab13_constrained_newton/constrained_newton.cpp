@@ -26,7 +26,10 @@ void require_columns(const char* function, const char* what, Eigen::Index got, E
   }
 }
 
-double max_abs(const Eigen::VectorXd& v) { return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff(); }
+// NaN when any entry is NaN (Eigen's default maxCoeff may skip one).
+double max_abs(const Eigen::VectorXd& v) {
+  return v.size() == 0 ? 0.0 : v.cwiseAbs().maxCoeff<Eigen::PropagateNaN>();
+}
 
 }  // namespace
 

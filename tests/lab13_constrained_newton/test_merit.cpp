@@ -1,6 +1,8 @@
 // Graded tests for lab13.5 and lab13.6: the merit's weights and value in
 // closed form, and the safeguard's rule.
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <limits>
 #include <stdexcept>
 
@@ -64,12 +66,23 @@ TEST_CASE("sufficient decrease is Armijo's rule on the merit", "[lab13][pts=2]")
   for (const double alpha : {1.0, 0.5, 0.125, 1.0 / 4096.0}) {
     CAPTURE(alpha);
     const double bound = (1.0 - 2.0 * cl::lab13::kArmijo * alpha) * psi;
-    CHECK(sufficient_decrease(psi, bound, alpha));
-    CHECK(sufficient_decrease(psi, 0.5 * bound, alpha));
-    CHECK_FALSE(sufficient_decrease(psi, std::nextafter(bound, 10.0), alpha));
-    CHECK_FALSE(sufficient_decrease(psi, psi, alpha));
-    CHECK_FALSE(sufficient_decrease(psi, std::nan(""), alpha));
-    CHECK_FALSE(sufficient_decrease(psi, INFINITY, alpha));
+    const std::string rule = "the bound (1 - 2 sigma alpha) psi(0) = " + std::to_string(bound);
+    auto call = [&](double after) {
+      char text[160];
+      std::snprintf(text, sizeof text, "sufficient_decrease(%.17g, %.17g, %.17g)", psi, after, alpha);
+      return std::string(text);
+    };
+    CHECK(cl::test::answer(call(bound), sufficient_decrease(psi, bound, alpha), true, "psi(alpha) equals " + rule));
+    CHECK(cl::test::answer(call(0.5 * bound), sufficient_decrease(psi, 0.5 * bound, alpha), true,
+                           "psi(alpha) is below " + rule));
+    const double above = std::nextafter(bound, 10.0);
+    CHECK(cl::test::answer(call(above), sufficient_decrease(psi, above, alpha), false,
+                           "psi(alpha) is one ulp above " + rule));
+    CHECK(cl::test::answer(call(psi), sufficient_decrease(psi, psi, alpha), false, "psi did not fall at all"));
+    CHECK(cl::test::answer(call(std::nan("")), sufficient_decrease(psi, std::nan(""), alpha), false,
+                           "a NaN merit is never a decrease"));
+    CHECK(cl::test::answer(call(INFINITY), sufficient_decrease(psi, INFINITY, alpha), false,
+                           "an infinite merit is never a decrease"));
   }
   CHECK_THROWS_AS(sufficient_decrease(psi, 1.0, 0.0), std::invalid_argument);
   CHECK_THROWS_AS(sufficient_decrease(psi, 1.0, 1.5), std::invalid_argument);
