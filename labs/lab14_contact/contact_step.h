@@ -59,12 +59,28 @@ std::vector<Contact> detect_contacts(const Eigen::Matrix3Xd& start, const Eigen:
 double max_penetration(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& inv_mass,
                        const std::vector<Collider>& colliders);
 
+// A scene that starts with particles inside colliders (contact-extremes does
+// on purpose). Left there, the first step's contacts would push each out by
+// its whole depth in one step, v = depth/Δt: kinetic energy from nowhere. So
+// the driver moves every movable particle that starts inside a collider to
+// the nearest point of its surface (x − s n, up to 8 passes over the
+// colliders for overlapping ones) before frame 0, velocities untouched, and
+// reports it. What it did:
+struct InitialPenetration {
+  int particles = 0;      // movable particles that started inside a collider (deeper than 1e-12 m)
+  int worst_particle = -1;
+  double deepest = 0.0;   // m, the deepest of them, before the move
+  double left = 0.0;      // m, max_penetration after the move (0 unless overlapping colliders trap one)
+};
+InitialPenetration resolve_initial_penetration(Particles& particles, const std::vector<Collider>& colliders);
+
 // What one step did at its contacts.
 struct StepReport {
   std::vector<Contact> contacts;
   // Per contact, N: constrained, the multipliers of its rows; pbd and xpbd,
   // the force that made the projection's move over the step, λ_n = d / (w Δt²)
-  // (d its normal correction) and λ_t = −(friction correction) / (w Δt²).
+  // (d its normal correction) and λ_t = (friction correction) / (w Δt²), the
+  // friction force: it points against the tangential move.
   std::vector<ContactMultipliers> multipliers;
   int active = 0;                 // contacts that acted: λ_n > 0 (the others were found but needed no push)
   int swept = 0;                  // contacts whose particle passed through the collider (Contact::swept)
@@ -79,7 +95,11 @@ struct StepReport {
   // colliders, or a collider the step's contacts did not list). 0 in a
   // scene whose colliders the contacts handle alone.
   int moved_back = 0;
-  std::string problem;            // constrained: the springs' matrix could not be factored (the step was not taken)
+  int linearizations = 0;         // constrained: the springs' rows solved at this many ends of the step (1–10)
+  // The step was not taken: constrained, the springs' matrix could not be
+  // factored; any method, a contact function threw std::invalid_argument
+  // (its message follows).
+  std::string problem;
 };
 
 // One scene's stepper: the springs as labs 04/08/07 want them, the movable
@@ -136,7 +156,7 @@ struct RunResult {
   double seconds = 0.0;
   double energy_start = 0.0;        // kinetic + potential, J
   double energy_end = 0.0;
-  double max_penetration = 0.0;     // over every step's end (not the scene's start, frame 0), m
+  double max_penetration = 0.0;     // over frame 0 and every step's end, m
   double max_normal_force = 0.0;    // over every step, N
   long long contacts = 0;           // Σ over steps of the contacts found (StepReport::contacts)
   long long active = 0;             // Σ over steps of the active ones (StepReport::active)

@@ -49,6 +49,9 @@ int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene&
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  const cl::lab14::InitialPenetration initial = cl::lab14::resolve_initial_penetration(scene.particles,
+                                                                                       scene.colliders);
+  if (initial.particles > 0) cl::lab14::report_initial_penetration(kLab, initial);
   if (live.on) return run_live(options, lab, scene);
   if (!options.out.empty()) cl::ensure_directory(options.out);
   const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
@@ -93,6 +96,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["sticking"] = result.sticking;
     summary.extra["sliding"] = result.sliding;
     summary.extra["max_penetration"] = result.max_penetration;
+    summary.extra["initial_penetration"] = initial.deepest;        // m, before the load moved them out
+    summary.extra["initial_penetration_particles"] = initial.particles;
     summary.extra["max_normal_force"] = result.max_normal_force;
     cl::add_energies(summary, cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
                      std::nullopt, result.energy_start);
@@ -118,8 +123,10 @@ int main(int argc, char** argv) {
   app.get_option("--iterations").range(1, 100000);
   LabOptions lab;
   cl::add_live_option(app, live);
-  app.add_option("--friction", lab.friction, "Coulomb's mu for every collider (default: each collider's own)")
-      .non_negative();
+  // μ above kMaxFriction sticks every contact as firmly as any larger one
+  // would; the cap keeps μ λ_n and μ d finite for any force a step can reach.
+  app.add_option("--friction", lab.friction, "Coulomb's mu for every collider, in [0, 1e6] (default: each collider's own)")
+      .finite_in(0.0, cl::lab14::kMaxFriction);
   const cl::Option method = app.get_option("--method");  // the experiments run every method
   app.add_flag("--drape", lab.drape, "experiment 1: every method x --frictions on the scene -> drape.csv")
       .excludes(method);
