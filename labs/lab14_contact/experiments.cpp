@@ -47,7 +47,7 @@ void report_initial_penetration(const char* lab_name, const InitialPenetration& 
                "%s: %d particle(s) start inside a collider, the deepest %.6g m (particle %d); moved out to the "
                "surface before frame 0, velocities unchanged%s\n",
                lab_name, initial.particles, initial.deepest, initial.worst_particle,
-               initial.left > 0.0 ? " (overlapping colliders left one inside)" : "");
+               initial.left > 1e-12 ? " (overlapping colliders left one inside)" : "");
 }
 
 Scene incline_scene(double degrees, double friction, int steps) {

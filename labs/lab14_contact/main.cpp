@@ -90,7 +90,6 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     if (lab.friction) summary.extra["friction"] = *lab.friction;
     summary.extra["contacts_found_per_step"] = found_per_step;
     summary.extra["contacts_active_per_step"] = active_per_step;
-    summary.extra["contacts_per_step"] = found_per_step;  // the name before contacts_found_per_step (handout)
     summary.extra["moved_back"] = result.moved_back;
     summary.extra["swept_contacts"] = result.swept;
     summary.extra["sticking"] = result.sticking;
