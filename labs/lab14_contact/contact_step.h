@@ -30,7 +30,8 @@ struct StepSettings {
   // pbd, xpbd: the springs' Gauss-Seidel sweeps (labs 04, 08), then as many
   // passes over the contacts (one is enough unless a particle touches two
   // colliders). constrained: block Gauss-Seidel iterations, each an exact
-  // solve of the spring rows and one PGS sweep over the contact rows. >= 1.
+  // solve of the spring rows and one PGS sweep over the contact rows, in each
+  // of up to 4 passes (the springs linearised anew each pass). >= 1.
   int iterations = 10;
   std::optional<double> friction;            // μ for every collider (--friction); unset: each collider's own
 };
@@ -118,7 +119,10 @@ class ContactStepper {
   // (README.md): u = v + Δtg + ΔtW(J_sᵀλ_s + f_c), λ_s solved exactly for the
   // contact forces f_c, the contacts detected on x → x + Δt u of the first
   // solve (margin: the largest Δt‖u_i‖), then contact_pgs_update on each;
-  // then lab 07's update_positions.
+  // all that repeated with the springs' rows linearised again at the end the
+  // last pass reached (refactored), until a pass moves no end by more than
+  // 1e-5 m, at most 4 passes (StepReport::linearizations; README.md,
+  // "Springs linearised at the end of the step"); then lab 07's update_positions.
   // Both: a particle that started outside every collider and ends more than
   // 1e-12 m inside one goes back along its move to where it first touches a
   // collider (StepReport::moved_back; README.md, "The last resort").
