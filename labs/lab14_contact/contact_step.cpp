@@ -430,6 +430,10 @@ StepReport ContactStepper::constrained_step(Particles& particles) {
       }
     }
   }
+  if (with_springs && report.linearizations == kMaxLinearizations) {
+    const double moved = dt * (velocity - previous_end_velocity).cwiseAbs().maxCoeff();
+    if (moved > kEndTolerance) report.unsettled = moved;
+  }
   const Eigen::Matrix3Xd start = particles.x;
   lab07::update_positions(particles, map_, velocity, dt);
   report.moved_back = move_back_inside(particles, start, colliders_, dt);
@@ -474,6 +478,8 @@ RunResult run_steps(Particles& particles, ContactStepper& stepper, const std::ve
     result.contacts += static_cast<long long>(r.contacts.size());
     result.active += r.active;
     result.moved_back += r.moved_back;
+    if (r.unsettled > 0.0) ++result.unsettled_steps;
+    result.max_unsettled = std::max(result.max_unsettled, r.unsettled);
     result.swept += r.swept;
     result.sticking += r.sticking;
     result.sliding += r.sliding;

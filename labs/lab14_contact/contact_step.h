@@ -96,7 +96,8 @@ struct StepReport {
   // colliders, or a collider the step's contacts did not list). 0 in a
   // scene whose colliders the contacts handle alone.
   int moved_back = 0;
-  int linearizations = 0;         // constrained: the springs' rows solved at this many ends of the step (1–10)
+  int linearizations = 0;         // constrained: the springs' rows solved at this many ends of the step (1–4)
+  double unsettled = 0.0;         // m: constrained, how far the 4th pass still moved an end (0: the passes settled)
   // The step was not taken: constrained, the springs' matrix could not be
   // factored; any method, a contact function threw std::invalid_argument
   // (its message follows).
@@ -166,6 +167,8 @@ struct RunResult {
   long long active = 0;             // Σ over steps of the active ones (StepReport::active)
   long long swept = 0, sticking = 0, sliding = 0;
   long long moved_back = 0;         // Σ over steps of StepReport::moved_back (particle-steps)
+  long long unsettled_steps = 0;    // constrained: steps whose 4th pass still moved an end by more than 1e-5 m
+  double max_unsettled = 0.0;       // m, the most such a pass moved
   std::string problem;
   int problem_step = -1;
   bool step_failed = false;

@@ -77,6 +77,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("  contacts per step: %.1f found, %.1f active (λ_n > 0); %lld swept, %lld sticking and %lld sliding "
               "contact-steps; %lld particle-steps moved back from inside a collider\n",
               found_per_step, active_per_step, result.swept, result.sticking, result.sliding, result.moved_back);
+  if (result.unsettled_steps > 0) {
+    std::printf("  %lld step(s) ended with the springs' rows still moving (their 4th pass moved an end by up to "
+                "%.3g m, above 1e-5 m)\n", result.unsettled_steps, result.max_unsettled);
+  }
   std::printf("  worst penetration %.3e m, largest normal force %.6g N, max strain %.3e\n", result.max_penetration,
               result.max_normal_force, strain.max);
   cl::print_energies("  energy: ", cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
@@ -95,6 +99,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["sticking"] = result.sticking;
     summary.extra["sliding"] = result.sliding;
     summary.extra["max_penetration"] = result.max_penetration;
+    summary.extra["unsettled_steps"] = result.unsettled_steps;
     summary.extra["initial_penetration"] = initial.deepest;        // m, before the load moved them out
     summary.extra["initial_penetration_particles"] = initial.particles;
     summary.extra["max_normal_force"] = result.max_normal_force;
