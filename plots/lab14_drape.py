@@ -17,7 +17,8 @@ from matplotlib.patches import Patch
 
 LAB = "lab14_contact"
 METHODS = ["pbd", "xpbd", "constrained"]
-FLOOR = 1e-18  # a penetration of exactly 0 is drawn here
+FLOOR = 1e-18  # a penetration of exactly 0 is drawn here (and the panel says so)
+KINETIC_FLOOR = 1e-12  # J: the history's kinetic energy below this (frame 0's 0) is drawn here
 
 
 def draw_table(table, target):
@@ -75,7 +76,10 @@ def draw_history(per_step, target):
     for key in (*counts, "sticking", "sliding"):
         left.plot(data["time"], data[key], label=key.replace("contacts_", ""))
     figures.finish(left, "time (s)", "contacts per step (1)")
-    right.semilogy(data["time"], [max(k, 1e-12) for k in data["kinetic"]])
+    right.semilogy(data["time"], [max(k, KINETIC_FLOOR) for k in data["kinetic"]])
+    if any(k < KINETIC_FLOOR for k in data["kinetic"]):
+        right.annotate(f"below {KINETIC_FLOOR:g} J (frame 0: 0) drawn at {KINETIC_FLOOR:g}", (0.02, 0.02),
+                       xycoords="axes fraction", fontsize=7)
     figures.finish(right, "time (s)", "kinetic energy (J)", legend=None)
     figure.suptitle(f"Lab 14: {per_step.parent.name}")
     figure.tight_layout()
