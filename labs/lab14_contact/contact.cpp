@@ -24,8 +24,8 @@ ContactProjection project_contact(const Eigen::Vector3d& p, double inv_mass, con
   not_implemented("project_contact", __FILE__);
 }
 
-// TODO(lab14.3) [4 pts] Δx_t = (I − n nᵀ)(p − x); undo it inside the cone
-// (‖Δx_t‖ <= μ d), shorten it by μ d outside. Graded by
+// TODO(lab14.3) [6 pts] Δx_t = (I − n nᵀ)(p − x); undo it inside the cone
+// (‖Δx_t‖ <= μ d: stuck, also when Δx_t = 0), shorten it by μ d outside. Graded by
 // tests/lab14_contact/test_friction.cpp and test_incline.cpp.
 Eigen::Vector3d friction_correction(const Eigen::Vector3d& x, const Eigen::Vector3d& p, double inv_mass,
                                     const Eigen::Vector3d& normal, double depth, double friction, bool& stuck) {
@@ -34,7 +34,7 @@ Eigen::Vector3d friction_correction(const Eigen::Vector3d& x, const Eigen::Vecto
   not_implemented("friction_correction", __FILE__);
 }
 
-// TODO(lab14.4) [5 pts] The normal row (clamped at 0), then the two tangent
+// TODO(lab14.4) [6 pts] The normal row (clamped at 0), then the two tangent
 // rows as one vector (clamped to the cone μ λ_n), each moving `velocity` by
 // Δt w times its change of force. Graded by tests/lab14_contact/test_pgs.cpp,
 // test_resting.cpp, test_incline.cpp and test_cloth.cpp.

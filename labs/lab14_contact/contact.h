@@ -17,7 +17,7 @@
 //     C(y) = n·(y − q) >= 0
 // on the particle's position y at the END of the step: n the collider's
 // outward unit normal and q a point of its surface where the particle meets
-// it (the given detect_contacts in simulation.h finds both). Colliders are
+// it (the given detect_contacts in contact_step.h finds both). Colliders are
 // convex, so a particle on the free side of that plane is outside the collider.
 #include <Eigen/Core>
 
@@ -43,7 +43,7 @@ struct SurfacePoint {
 SurfacePoint surface_distance(const Collider& collider, const Eigen::Vector3d& x);
 
 // A contact of one particle with one collider for one step (given code:
-// detect_contacts in simulation.h fills it).
+// detect_contacts in contact_step.h fills it).
 struct Contact {
   int particle = 0;
   int collider = 0;                                   // index in the scene's colliders
@@ -86,7 +86,9 @@ ContactProjection project_contact(const Eigen::Vector3d& p, double inv_mass, con
 // particle and never reverses its tangential move. Zero when w = 0 (pinned),
 // d = 0 or Δx_t = 0. The correction is tangential: n·correction = 0 (to
 // round-off), so the contact stays met. `stuck` is set to whether the static
-// case applied (d > 0 and ‖Δx_t‖ <= μ d), false otherwise.
+// case applied: w > 0, d > 0 and ‖Δx_t‖ <= μ d (true too for a particle
+// pressed onto the surface with no tangential move, Δx_t = 0), false
+// otherwise. The driver counts sticking and sliding contacts by it.
 // Throws std::invalid_argument for a non-finite x, p or normal, a normal not of
 // length 1 (as project_contact), a negative or non-finite inverse mass, depth
 // or friction.

@@ -30,7 +30,8 @@ struct StepSettings {
   // pbd, xpbd: the springs' Gauss-Seidel sweeps (labs 04, 08), then as many
   // passes over the contacts (one is enough unless a particle touches two
   // colliders). constrained: block Gauss-Seidel iterations, each an exact
-  // solve of the spring rows and one PGS sweep over the contact rows. >= 1.
+  // solve of the spring rows and one PGS sweep over the contact rows, in each
+  // of up to 4 passes (the springs linearised anew each pass). >= 1.
   int iterations = 10;
   std::optional<double> friction;            // μ for every collider (--friction); unset: each collider's own
 };
@@ -59,12 +60,28 @@ std::vector<Contact> detect_contacts(const Eigen::Matrix3Xd& start, const Eigen:
 double max_penetration(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& inv_mass,
                        const std::vector<Collider>& colliders);
 
+// A scene that starts with particles inside colliders (contact-extremes does
+// on purpose). Left there, the first step's contacts would push each out by
+// its whole depth in one step, v = depth/Δt: kinetic energy from nowhere. So
+// the driver moves every movable particle that starts inside a collider to
+// the nearest point of its surface (x − s n, up to 8 passes over the
+// colliders for overlapping ones) before frame 0, velocities untouched, and
+// reports it. What it did:
+struct InitialPenetration {
+  int particles = 0;      // movable particles that started inside a collider (deeper than 1e-12 m)
+  int worst_particle = -1;
+  double deepest = 0.0;   // m, the deepest of them, before the move
+  double left = 0.0;      // m, max_penetration after the move (0 unless overlapping colliders trap one)
+};
+InitialPenetration resolve_initial_penetration(Particles& particles, const std::vector<Collider>& colliders);
+
 // What one step did at its contacts.
 struct StepReport {
   std::vector<Contact> contacts;
   // Per contact, N: constrained, the multipliers of its rows; pbd and xpbd,
   // the force that made the projection's move over the step, λ_n = d / (w Δt²)
-  // (d its normal correction) and λ_t = −(friction correction) / (w Δt²).
+  // (d its normal correction) and λ_t = (friction correction) / (w Δt²), the
+  // friction force: it points against the tangential move.
   std::vector<ContactMultipliers> multipliers;
   int active = 0;                 // contacts that acted: λ_n > 0 (the others were found but needed no push)
   int swept = 0;                  // contacts whose particle passed through the collider (Contact::swept)
@@ -79,7 +96,12 @@ struct StepReport {
   // colliders, or a collider the step's contacts did not list). 0 in a
   // scene whose colliders the contacts handle alone.
   int moved_back = 0;
-  std::string problem;            // constrained: the springs' matrix could not be factored (the step was not taken)
+  int linearizations = 0;         // constrained: the springs' rows solved at this many ends of the step (1–4)
+  double unsettled = 0.0;         // m: constrained, how far the 4th pass still moved an end (0: the passes settled)
+  // The step was not taken: constrained, the springs' matrix could not be
+  // factored; any method, a contact function threw std::invalid_argument
+  // (its message follows).
+  std::string problem;
 };
 
 // One scene's stepper: the springs as labs 04/08/07 want them, the movable
@@ -98,7 +120,10 @@ class ContactStepper {
   // (README.md): u = v + Δtg + ΔtW(J_sᵀλ_s + f_c), λ_s solved exactly for the
   // contact forces f_c, the contacts detected on x → x + Δt u of the first
   // solve (margin: the largest Δt‖u_i‖), then contact_pgs_update on each;
-  // then lab 07's update_positions.
+  // all that repeated with the springs' rows linearised again at the end the
+  // last pass reached (refactored), until a pass moves no end by more than
+  // 1e-5 m, at most 4 passes (StepReport::linearizations; README.md,
+  // "Springs linearised at the end of the step"); then lab 07's update_positions.
   // Both: a particle that started outside every collider and ends more than
   // 1e-12 m inside one goes back along its move to where it first touches a
   // collider (StepReport::moved_back; README.md, "The last resort").
@@ -136,12 +161,14 @@ struct RunResult {
   double seconds = 0.0;
   double energy_start = 0.0;        // kinetic + potential, J
   double energy_end = 0.0;
-  double max_penetration = 0.0;     // over every step's end (not the scene's start, frame 0), m
+  double max_penetration = 0.0;     // over frame 0 and every step's end, m
   double max_normal_force = 0.0;    // over every step, N
   long long contacts = 0;           // Σ over steps of the contacts found (StepReport::contacts)
   long long active = 0;             // Σ over steps of the active ones (StepReport::active)
   long long swept = 0, sticking = 0, sliding = 0;
   long long moved_back = 0;         // Σ over steps of StepReport::moved_back (particle-steps)
+  long long unsettled_steps = 0;    // constrained: steps whose 4th pass still moved an end by more than 1e-5 m
+  double max_unsettled = 0.0;       // m, the most such a pass moved
   std::string problem;
   int problem_step = -1;
   bool step_failed = false;

@@ -35,11 +35,19 @@ void check_lab_options(const LabOptions& lab) {
   }
   if (lab.drape && !lab.angles.empty()) throw InputError("--angles: only with --incline");
   for (std::size_t f = 0; f < lab.frictions.size(); ++f) {
-    if (!(std::isfinite(lab.frictions[f]) && lab.frictions[f] >= 0.0)) {
-      throw InputError("--frictions[" + std::to_string(f) + "]: must be a finite number >= 0 (got " +
+    if (!(std::isfinite(lab.frictions[f]) && lab.frictions[f] >= 0.0 && lab.frictions[f] <= kMaxFriction)) {
+      throw InputError("--frictions[" + std::to_string(f) + "]: must be a finite number >= 0 and <= 1e6 (got " +
                        std::to_string(lab.frictions[f]) + ")");
     }
   }
+}
+
+void report_initial_penetration(const char* lab_name, const InitialPenetration& initial) {
+  std::fprintf(stderr,
+               "%s: %d particle(s) start inside a collider, the deepest %.6g m (particle %d); moved out to the "
+               "surface before frame 0, velocities unchanged%s\n",
+               lab_name, initial.particles, initial.deepest, initial.worst_particle,
+               initial.left > 1e-12 ? " (overlapping colliders left one inside)" : "");
 }
 
 Scene incline_scene(double degrees, double friction, int steps) {
@@ -63,7 +71,9 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
   refuse_run_flags(options, "--drape writes drape.csv, not one run's trajectory",
                    "--drape writes drape.csv, not one run's summary");
   if (lab.friction) throw InputError("--friction: --drape sweeps --frictions instead");
-  const Scene loaded = load_scene_for(options, scene_dir);
+  Scene loaded = load_scene_for(options, scene_dir);
+  const InitialPenetration initial = resolve_initial_penetration(loaded.particles, loaded.colliders);
+  if (initial.particles > 0) report_initial_penetration(lab_name, initial);
   start_run(options);
   double mass = 0.0;
   for (Eigen::Index i = 0; i < loaded.particles.size(); ++i) {

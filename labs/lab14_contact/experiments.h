@@ -28,9 +28,17 @@ inline constexpr const char* kDefaultScene = "drape-sphere";
 inline const std::vector<double> kFrictions{0.0, 0.3, 1.0};
 inline const std::vector<double> kAngles{5, 10, 15, 16, 16.5, 16.9, 17, 20, 30, 40, 44, 44.9, 45.1, 46, 50, 60};
 
+// The largest μ a flag takes (--friction, --frictions).
+inline constexpr double kMaxFriction = 1e6;
+
 // Throws InputError for --frictions or --angles given without an experiment,
-// or a friction that is not a finite number >= 0.
+// or a friction that is not a finite number in [0, kMaxFriction].
 void check_lab_options(const LabOptions& lab);
+
+// One stderr line for a scene whose particles start inside colliders: how
+// many, the deepest and which particle, and that they were moved out to the
+// surface before frame 0 (no kinetic energy given to them).
+void report_initial_penetration(const char* lab_name, const InitialPenetration& initial);
 
 // The step settings of a run: --method, --iterations, the scene's dt and
 // gravity, --friction.

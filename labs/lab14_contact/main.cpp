@@ -49,6 +49,9 @@ int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene&
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  const cl::lab14::InitialPenetration initial = cl::lab14::resolve_initial_penetration(scene.particles,
+                                                                                       scene.colliders);
+  if (initial.particles > 0) cl::lab14::report_initial_penetration(kLab, initial);
   if (live.on) return run_live(options, lab, scene);
   cl::start_run(options);
   const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
@@ -74,6 +77,10 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("  contacts per step: %.1f found, %.1f active (λ_n > 0); %lld swept, %lld sticking and %lld sliding "
               "contact-steps; %lld particle-steps moved back from inside a collider\n",
               found_per_step, active_per_step, result.swept, result.sticking, result.sliding, result.moved_back);
+  if (result.unsettled_steps > 0) {
+    std::printf("  %lld step(s) ended with the springs' rows still moving (their 4th pass moved an end by up to "
+                "%.3g m, above 1e-5 m)\n", result.unsettled_steps, result.max_unsettled);
+  }
   std::printf("  worst penetration %.3e m, largest normal force %.6g N, max strain %.3e\n", result.max_penetration,
               result.max_normal_force, strain.max);
   cl::print_energies("  energy: ", cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
@@ -87,12 +94,14 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     if (lab.friction) summary.extra["friction"] = *lab.friction;
     summary.extra["contacts_found_per_step"] = found_per_step;
     summary.extra["contacts_active_per_step"] = active_per_step;
-    summary.extra["contacts_per_step"] = found_per_step;  // the name before contacts_found_per_step (handout)
     summary.extra["moved_back"] = result.moved_back;
     summary.extra["swept_contacts"] = result.swept;
     summary.extra["sticking"] = result.sticking;
     summary.extra["sliding"] = result.sliding;
     summary.extra["max_penetration"] = result.max_penetration;
+    summary.extra["unsettled_steps"] = result.unsettled_steps;
+    summary.extra["initial_penetration"] = initial.deepest;        // m, before the load moved them out
+    summary.extra["initial_penetration_particles"] = initial.particles;
     summary.extra["max_normal_force"] = result.max_normal_force;
     cl::add_energies(summary, cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
                      std::nullopt, result.energy_start);
@@ -118,8 +127,10 @@ int main(int argc, char** argv) {
   app.get_option("--iterations").range(1, 100000);
   LabOptions lab;
   cl::add_live_option(app, live);
-  app.add_option("--friction", lab.friction, "Coulomb's mu for every collider (default: each collider's own)")
-      .non_negative();
+  // μ above kMaxFriction sticks every contact as firmly as any larger one
+  // would; the cap keeps μ λ_n and μ d finite for any force a step can reach.
+  app.add_option("--friction", lab.friction, "Coulomb's mu for every collider, in [0, 1e6] (default: each collider's own)")
+      .finite_in(0.0, cl::lab14::kMaxFriction);
   const cl::Option method = app.get_option("--method");  // the experiments run every method
   app.add_flag("--drape", lab.drape, "experiment 1: every method x --frictions on the scene -> drape.csv")
       .excludes(method);

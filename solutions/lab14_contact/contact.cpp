@@ -96,9 +96,9 @@ Eigen::Vector3d friction_correction(const Eigen::Vector3d& x, const Eigen::Vecto
   const Eigen::Vector3d move = p - x;
   const Eigen::Vector3d tangential = move - normal.dot(move) * normal;
   const double length = tangential.norm();
-  if (inv_mass == 0.0 || depth == 0.0 || length == 0.0) return Eigen::Vector3d::Zero();
+  if (inv_mass == 0.0 || depth == 0.0) return Eigen::Vector3d::Zero();
   const double bound = friction * depth;
-  if (length <= bound) {
+  if (length <= bound) {  // with Δx_t = 0 too: pressed on, not sliding
     stuck = true;
     return -tangential;
   }

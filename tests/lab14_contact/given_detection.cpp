@@ -3,8 +3,9 @@
 // floor. A particle thrown into the crease where they meet, its move missing
 // the sphere and ending below both, must not get a contact on the sphere's
 // bottom (a surface point inside the floor's solid, facing the floor's
-// contact): with both, the converged constrained step drove a particle of the
-// extremes matrix 14 m away (bench/README.md, "Lab 14's contact cells").
+// contact): with both, a converged constrained step can drive the particle to
+// the far tip of the two half-spaces' thin wedge. Also: a particle that starts
+// inside a collider is moved out at load (resolve_initial_penetration).
 #include <catch2/catch.hpp>
 
 #include "common/metrics.h"
@@ -78,4 +79,30 @@ TEST_CASE("a converged constrained step into a sphere-in-floor crease does not r
   const cl::lab14::StepReport report = stepper.step(scene.particles);
   REQUIRE(report.problem.empty());
   CHECK(cl::test::at_most("kinetic + potential energy after the step (J)", energy(scene.particles), before));
+}
+
+TEST_CASE("a particle that starts inside a sphere is moved out at load and gains no kinetic energy",
+          "[lab14_given]") {
+  using namespace lab14_test;
+  // 0.15 m deep in a ball of radius 0.2 m, no gravity: pushed out by the first
+  // step's contact it would leave at 0.15 m / Δt = 9 m/s. Moved out at load,
+  // it rests on the surface, at rest, for every method.
+  for (const cl::lab14::Method method : kMethods) {
+    CAPTURE(cl::lab14::method_name(method));
+    cl::Scene scene = particle(Eigen::Vector3d(0.05, 0.0, 0.0), Eigen::Vector3d::Zero());
+    scene.colliders.push_back(sphere(Eigen::Vector3d::Zero(), 0.2));
+    const cl::lab14::InitialPenetration initial =
+        cl::lab14::resolve_initial_penetration(scene.particles, scene.colliders);
+    CHECK(initial.particles == 1);
+    CHECK(cl::test::near(initial.deepest, 0.15, 1e-15, "depth before the move (m)"));
+    CHECK(cl::test::near(scene.particles.x.col(0).norm(), 0.2, 1e-15, "distance from the centre after it (m)"));
+    cl::lab14::StepSettings settings = settings_for(method);
+    settings.gravity.setZero();
+    cl::lab14::ContactStepper stepper(scene, settings);
+    for (int step = 0; step < 30; ++step) REQUIRE(cl::test::healthy(stepper.step(scene.particles)));
+    CHECK(cl::test::at_most("kinetic energy after 30 steps (J)", cl::kinetic_energy(scene.particles), 1e-20));
+    CHECK(cl::test::at_most("penetration (m)",
+                            cl::lab14::max_penetration(scene.particles.x, scene.particles.inv_mass, scene.colliders),
+                            1e-12));
+  }
 }

@@ -47,3 +47,39 @@ TEST_CASE("kinetic friction shortens the tangential move by mu d and never rever
   CHECK_THROWS_AS(cl::lab14::friction_correction(x, x + move, 1.0, normal, -0.1, 0.5, stuck), std::invalid_argument);
   CHECK_THROWS_AS(cl::lab14::friction_correction(x, x + move, 1.0, normal, 0.1, -0.5, stuck), std::invalid_argument);
 }
+
+TEST_CASE("friction's bound mu d is a length: the same for every mass", "[lab14][pts=1]") {
+  // μ d compares two moves (m); the inverse mass has no place in it. A bound
+  // weighted by w, μ d w, holds a heavy particle too little and a light one too much.
+  const Eigen::Vector3d normal(0.0, 1.0, 0.0);
+  const Eigen::Vector3d x(0.1, 0.2, 0.3);
+  const Eigen::Vector3d tangent = Eigen::Vector3d(3.0, 0.0, -4.0) / 5.0;
+  const double mu = 0.5, depth = 0.02;  // μ d = 0.01 m
+  for (const double inv_mass : {1e-3, 0.25, 4.0, 1e3}) {
+    CAPTURE(inv_mass);
+    bool stuck = false;
+    const Eigen::Vector3d inside = x + 0.009 * tangent - 0.003 * normal;  // ‖Δx_t‖ = 0.9 μ d: static
+    Eigen::Vector3d correction = cl::lab14::friction_correction(x, inside, inv_mass, normal, depth, mu, stuck);
+    CHECK(cl::test::near(correction, Eigen::Vector3d(-0.009 * tangent), 1e-16, "static correction"));
+    CHECK(cl::test::answer("friction_correction(‖Δx_t‖ = 0.9 μ d) stuck", stuck, true, "‖Δx_t‖ <= μ d"));
+    const Eigen::Vector3d outside = x + 0.011 * tangent - 0.003 * normal;  // ‖Δx_t‖ = 1.1 μ d: kinetic
+    correction = cl::lab14::friction_correction(x, outside, inv_mass, normal, depth, mu, stuck);
+    CHECK(cl::test::near(correction, Eigen::Vector3d(-0.01 * tangent), 1e-16, "kinetic correction (length μ d)"));
+    CHECK(cl::test::answer("friction_correction(‖Δx_t‖ = 1.1 μ d) stuck", stuck, false, "‖Δx_t‖ > μ d"));
+  }
+}
+
+TEST_CASE("a particle pressed onto the surface with no tangential move is stuck", "[lab14][pts=1]") {
+  // Δx_t = 0 <= μ d: the static case, with nothing to undo. The driver's
+  // sticking and sliding counts come from `stuck`.
+  const Eigen::Vector3d normal(0.0, 1.0, 0.0);  // the tangential part of a move along it is exactly 0
+  const Eigen::Vector3d x(0.2, 0.1, -0.3);
+  for (const double mu : {0.3, 1.0}) {
+    CAPTURE(mu);
+    bool stuck = false;
+    const Eigen::Vector3d correction =
+        cl::lab14::friction_correction(x, x - 0.004 * normal, 1.0, normal, 0.004, mu, stuck);
+    CHECK(cl::test::near(correction, Eigen::Vector3d::Zero(), 0.0, "correction"));
+    CHECK(cl::test::answer("friction_correction(Δx_t = 0, d > 0) stuck", stuck, true, "0 <= μ d"));
+  }
+}

@@ -85,3 +85,23 @@ TEST_CASE("pgs update slides at mu times the normal force and sticks inside the 
   CHECK_THROWS_AS(cl::lab14::contact_pgs_update(Eigen::Vector3d::Zero(), 1.0, 0.0, floor_contact(0.4), lambda, velocity),
                   std::invalid_argument);
 }
+
+TEST_CASE("pgs update clamps the accumulated lambda_n: a warm lambda_n falls when the contact opens",
+          "[lab14][pts=1]") {
+  // A warm start (the previous sweep's λ_n) whose push is no longer needed: the
+  // new λ_n is max(0, λ_n − r_n/A), which can be smaller than the old one. A
+  // clamp on the increment, λ_n + max(0, −r_n/A), can only keep or raise it.
+  const double dt = lab14_test::kDt, w = 1.0, a = dt * dt * w;
+  const Eigen::Vector3d x(0.0, 0.01, 0.0);  // 1 cm above the floor
+  for (const double warm : {5.0, 200.0}) {
+    CAPTURE(warm);
+    Eigen::Vector3d velocity(0.0, 1.0, 0.0);  // leaving the floor at 1 m/s, with the warm force in it
+    const double gap = x.y() + dt * velocity.y();
+    const double expected = std::max(0.0, warm - gap / a);
+    cl::lab14::ContactMultipliers lambda;
+    lambda.normal = warm;
+    cl::lab14::contact_pgs_update(x, w, dt, floor_contact(0.0), lambda, velocity);
+    CHECK(cl::test::near(lambda.normal, expected, 1e-12 * warm, "λ_n' = max(0, λ_n − r_n/A) (N)"));
+    CHECK(cl::test::near(velocity.y(), 1.0 + dt * w * (expected - warm), 1e-14, "v_y after the update (m/s)"));
+  }
+}
