@@ -341,6 +341,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     const double wait = paused ? 0.05 : std::chrono::duration<double>(next_due - Clock::now()).count();
     server.wait_inbound(std::min(std::max(wait, 0.0), 0.05));
   }
+  live_log_flush(true);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
   for (auto& [p, hold] : holds) state.inv_mass[p] = hold.inv_mass;

@@ -105,8 +105,8 @@ LogState& log_state() {
   return state;
 }
 
-void log_roll(LogState& state, Clock::time_point now) {  // with state.mutex held
-  if (since(state.window, now) < 1.0) return;
+void log_roll(LogState& state, Clock::time_point now, bool final = false) {  // with state.mutex held
+  if (since(state.window, now) < 1.0 && !final) return;
   if (state.hidden > 0) {
     std::fprintf(stderr, "live: %ld more lines like these in the last %.0f s, not shown\n", state.hidden,
                  std::max(1.0, since(state.window, now)));
@@ -130,10 +130,10 @@ void live_log(const std::string& line) {
   }
 }
 
-void live_log_flush() {
+void live_log_flush(bool final) {
   LogState& state = log_state();
   const std::lock_guard<std::mutex> lock(state.mutex);
-  log_roll(state, Clock::now());
+  log_roll(state, Clock::now(), final);
 }
 
 WebSocketHeader parse_websocket_header(const char* data, std::size_t size) {
@@ -257,6 +257,7 @@ struct LiveServer::Loop {
     bool in_message = false;      // continuation frames expected
     bool refusing = false;        // the message in progress is refused: its frames are discarded
     std::uint64_t skip = 0;       // payload bytes of a refused frame still to discard
+    bool spoke = false;           // kSocket: it has sent something since its handshake
   };
 
   LiveServer* server = nullptr;
@@ -269,7 +270,7 @@ struct LiveServer::Loop {
 
   void run();
   void accept_new(Clock::time_point now);
-  bool read_some(Connection& connection);
+  bool read_some(Connection& connection, Clock::time_point now);
   void handle_request(Connection& connection, Clock::time_point now);
   void handle_frames(Connection& connection, Clock::time_point now);
   void fill(Connection& connection);
@@ -428,7 +429,7 @@ void LiveServer::Loop::run() {
         close_connection(connection, "");
         continue;
       }
-      if ((revents & (POLLIN | POLLHUP)) != 0 && !read_some(*connection)) {
+      if ((revents & (POLLIN | POLLHUP)) != 0 && !read_some(*connection, now)) {
         close_connection(connection, "");
         continue;
       }
@@ -500,7 +501,7 @@ void LiveServer::Loop::accept_new(Clock::time_point now) {
   }
 }
 
-bool LiveServer::Loop::read_some(Connection& connection) {
+bool LiveServer::Loop::read_some(Connection& connection, Clock::time_point now) {
   char buffer[65536];
   for (int k = 0; k < 4; ++k) {
     const std::size_t room = connection.skip > 0 ? sizeof buffer : std::min(sizeof buffer, 65536 - std::min<std::size_t>(connection.in.size(), 65536));
@@ -508,6 +509,7 @@ bool LiveServer::Loop::read_some(Connection& connection) {
     const ssize_t got = recv(connection.fd, buffer, room, MSG_DONTWAIT);
     if (got == 0) return false;
     if (got < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR;
+    if (connection.state == State::kSocket) connection.heard = now, connection.spoke = true;
     std::size_t used = 0;
     const std::size_t size = static_cast<std::size_t>(got);
     if (connection.skip > 0 && connection.in.empty()) {  // a refused payload: discarded as it comes, never kept
@@ -588,13 +590,17 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
     const std::lock_guard<std::mutex> lock(shared->mutex);
     int open = 0, quietest = 0;
     for (const auto& [id, client] : shared->clients) open += client.gone || client.evict ? 0 : 1;
-    if (open >= kMaxClients) {  // the one heard from least recently makes room: a reload or a new tab always connects
-      Clock::time_point oldest = Clock::time_point::max();
+    if (open >= kMaxClients) {
+      // A reload or a new tab always connects: the oldest of the clients that never said a word makes
+      // room, else the one heard from least recently.
+      auto rank = [](const Connection& other) { return std::make_pair(other.spoke, other.heard); };
+      const Connection* quiet = nullptr;
       for (const Connection& other : connections) {
-        if (other.state == State::kSocket && !shared->clients[other.client].evict && other.heard < oldest) {
-          oldest = other.heard, quietest = other.client;
+        if (other.state == State::kSocket && !shared->clients[other.client].evict && (quiet == nullptr || rank(other) < rank(*quiet))) {
+          quiet = &other;
         }
       }
+      quietest = quiet == nullptr ? 0 : quiet->client;
       if (quietest != 0) shared->clients[quietest].evict = true;
     }
     connection.client = shared->next_client++;

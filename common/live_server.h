@@ -106,7 +106,7 @@ bool live_token_matches(const char* query, const std::string& token);
 // the second is over) prints "live: N more lines like these ... not shown".
 constexpr int kLiveLogPerSecond = 10;
 void live_log(const std::string& line);
-void live_log_flush();
+void live_log_flush(bool final = false);  // final: the summary now, whatever the time
 
 // The WebSocket wire format (RFC 6455), pure functions for the unit tests.
 // A frame's header at the front of `data`: complete false when more bytes are
