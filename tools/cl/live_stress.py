@@ -250,6 +250,60 @@ class Stress:
         return self.problems, self.numbers
 
 
+def problem_and_reset(port, token):
+    """A drag 1000 m away makes the run unstable (strain over 1000): a page opened then is greeted with
+    the problem and the last good frame, and reset alone makes the run go on. Returns what went wrong."""
+    import websocket  # Debian's python3-websocket
+
+    def statuses(client, seconds):
+        """(text messages, status of each frame) until `seconds` pass; every frame acknowledged."""
+        end, texts, status = time.monotonic() + seconds, [], None
+        while time.monotonic() < end:
+            client.settimeout(max(0.01, end - time.monotonic()))
+            try:
+                message = client.recv()
+            except websocket.WebSocketTimeoutException:
+                break
+            if isinstance(message, bytes):
+                client.send('{"cmd": "ack"}')
+                yield texts, status
+            else:
+                texts.append(json.loads(message))
+                status = texts[-1] if texts[-1].get("type") == "frame" else status
+
+    url = f"ws://127.0.0.1:{port}/ws?token={token}"
+    first = websocket.create_connection(url, timeout=5)
+    for texts, status in statuses(first, 3):
+        break
+    else:
+        return ["problem and reset: the first client got no frame"]
+    particle = max(p for p in range(texts[0]["particles"]) if p not in status["pinned"])
+    first.send(json.dumps({"cmd": "drag", "particle": particle, "x": [1000, 0, 0]}))
+    problems = ["problem and reset: a drag 1000 m away did not stop the run within 3 s"]
+    for texts, status in statuses(first, 3):
+        if status and status["problem"] and status["paused"]:
+            problems = []
+            break
+    late = websocket.create_connection(url, timeout=5)
+    for texts, status in statuses(late, 3):
+        if status:
+            break
+    kinds = [m.get("type") for m in texts]
+    if kinds[:2] != ["hello", "problem"] or not status or not status["problem"]:
+        problems.append(f"problem and reset: a page opened after the problem got {kinds[:3]} "
+                        f"(the hello, the problem, a frame showing it expected)")
+    first.send('{"cmd": "reset"}')
+    for texts, status in statuses(first, 3):
+        if status and status["frame"] >= 10 and not status["paused"] and not status["problem"]:
+            break
+    else:
+        problems.append(f"problem and reset: after reset the run did not go on by itself (last status "
+                        f"frame {status and status['frame']}, paused {status and status['paused']})")
+    first.close()
+    late.close()
+    return problems
+
+
 def check_stress(program):
     """Runs the stress against `program --live` on a 16² curtain; (problems, numbers)."""
     import signal
@@ -261,6 +315,7 @@ def check_stress(program):
     try:
         port, token = read_url(process, 20)
         problems, numbers = Stress(port, token, process.pid).run()
+        problems += problem_and_reset(port, token)
         start = time.monotonic()
         process.send_signal(signal.SIGTERM)
         code = process.wait(timeout=5)
