@@ -24,6 +24,7 @@ from pathlib import Path
 
 from .base import BIN, BUILD
 from .live import read_url
+from .live_handouts import check_handouts
 from .live_stress import FLOOD, check_stress
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
@@ -260,7 +261,14 @@ def check_live(checks):
     started = time.monotonic()
     # The stress test runs beside the browser's, on a program of its own: the two share the 20 s.
     stress = {}
-    stressing = threading.Thread(target=lambda: stress.update(zip(("problems", "numbers"), check_stress(program))))
+
+    def beside():  # the stress, then the handouts' live sections (each a program of its own)
+        stress.update(zip(("problems", "numbers"), check_stress(program)))
+        handouts_started = time.monotonic()
+        stress["handouts"] = check_handouts()
+        stress["handouts_seconds"] = time.monotonic() - handouts_started
+
+    stressing = threading.Thread(target=beside)
     stressing.start()
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live", "--summary", str(summary)],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -299,7 +307,7 @@ def check_live(checks):
                   "a drag of 0.2 m held (and marked) and followed, a shift-click pin, reset, K turned in the page, a "
                   "malformed message refused while frames kept coming, a second client gone mid-drag, no token and a foreign Origin refused, stop: exit 0",
                   problems)
-    stressing.join(timeout=60)
+    stressing.join(timeout=120)
     numbers = stress.get("numbers", {})
     checks.record(not stressing.is_alive() and not stress.get("problems", ["the stress test did not finish"]),
                   "live under stress, beside it: 3 clients that ack and never read, a flood of "
@@ -310,3 +318,7 @@ def check_live(checks):
                   f"+{numbers.get('rss_rise_mb', 0):.1f} MB for the 100 MB message (under 10); SIGTERM "
                   f"{numbers.get('sigterm_seconds', 0):.2f} s; {numbers.get('stderr_lines')} stderr lines",
                   stress.get("problems", ["the stress test did not finish within 60 s"]))
+    checks.record("handouts" in stress and not stress["handouts"],
+                  f"live: the handouts' \"Try it live\" numbers and effects (labs 04, 06, 14) on the reference, driven "
+                  f"over the page's socket ({stress.get('handouts_seconds', 0):.0f} s)",
+                  stress.get("handouts", ["the handouts' live checks did not finish"]))
