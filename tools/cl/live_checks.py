@@ -11,7 +11,6 @@ the token and of a foreign Origin, and the page's stop (exit 0, the summary
 with the new K)."""
 import json
 import math
-import re
 import os
 import shutil
 import signal
