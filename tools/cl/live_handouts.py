@@ -192,11 +192,17 @@ def lab14():
 
 
 def check_handouts():
-    """Every live section's numbers and effects; a list of what went wrong."""
+    """Every live section's numbers and effects; a list of what went wrong. A student release of an
+    early week has no later lab's reference: its sections wait for that week."""
+    import websocket  # Debian's python3-websocket
+    from .release import is_release
     problems = []
-    for check in (lab04, lab06, lab14):
+    checks = {"lab04_pbd": lab04, "lab06_projective_dynamics": lab06, "lab14_contact": lab14}
+    for lab, check in checks.items():
+        if is_release() and not (BIN / f"{lab}_solution").is_file():
+            continue
         try:
             problems += check()
-        except (RuntimeError, OSError, subprocess.TimeoutExpired, ValueError, KeyError) as error:
+        except (RuntimeError, OSError, subprocess.TimeoutExpired, ValueError, KeyError, websocket.WebSocketException) as error:
             problems.append(f"{check.__name__}: {type(error).__name__}: {error}")
     return problems
