@@ -262,9 +262,15 @@ def check_live(checks):
     stress = {}
 
     def beside():  # the stress, then the handouts' live sections (each a program of its own)
-        stress.update(zip(("problems", "numbers"), check_stress(program)))
+        try:
+            stress.update(zip(("problems", "numbers"), check_stress(program)))
+        except Exception as error:  # noqa: BLE001 (a thread's error is a check's problem, not a lost traceback)
+            stress["problems"] = [f"the stress test: {type(error).__name__}: {error}"]
         handouts_started = time.monotonic()
-        stress["handouts"] = check_handouts()
+        try:
+            stress["handouts"] = check_handouts()
+        except Exception as error:  # noqa: BLE001
+            stress["handouts"] = [f"the handouts' live checks: {type(error).__name__}: {error}"]
         stress["handouts_seconds"] = time.monotonic() - handouts_started
 
     stressing = threading.Thread(target=beside)
