@@ -613,6 +613,10 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
   connection.out_at = 0;
   connection.state = State::kSocket;
   connection.heard = connection.progress = connection.pinged = now;
+  // The kernel's own queue for a WebSocket is bounded too (Linux would let it grow to 4 MB): a client
+  // that reads nothing fills it within a second or two and is dropped 5 s later.
+  const int queue = 256 << 10;
+  setsockopt(connection.fd, SOL_SOCKET, SO_SNDBUF, &queue, sizeof queue);
 }
 
 // A line refusing a client's message: to that client (as the loop's refusals are) and to stderr.

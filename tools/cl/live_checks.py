@@ -315,7 +315,8 @@ def check_live(checks):
     stressing.join(timeout=120)
     numbers = stress.get("numbers", {})
     checks.record(not stressing.is_alive() and not stress.get("problems", ["the stress test did not finish"]),
-                  "live under stress, beside it: 3 clients that ack and never read, a flood of "
+                  "live under stress, beside it: 3 clients that ack and never read (dropped after "
+                  f"{numbers.get('ackers_dropped_after')} s), a flood of "
                   f"{FLOOD} refused messages ({numbers.get('flood_answered')} answered), 50 sockets held and a 100 MB "
                   f"message, while an honest client got {numbers.get('honest_fps')} frames/s (median, at least 20) "
                   f"and {numbers.get('honest_answered')} answers; the page in {numbers.get('page_seconds', 0):.2f} s, "

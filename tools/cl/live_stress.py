@@ -247,6 +247,9 @@ class Stress:
             thread.join(timeout=15)
         if honest.is_alive() or any(thread.is_alive() for thread in abusers):
             self.problem("a client of the stress test did not finish in time")
+        if len(self.numbers.get("ackers_dropped_after", [])) != 3:
+            self.problem(f"of the 3 clients that never read, {len(self.numbers.get('ackers_dropped_after', []))} were "
+                         f"dropped within {SECONDS:.0f} s")
         return self.problems, self.numbers
 
 
