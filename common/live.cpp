@@ -53,6 +53,7 @@ struct Hold {
   double inv_mass = 0.0;
   Eigen::Vector3d target = Eigen::Vector3d::Zero();
   std::vector<Eigen::Vector3d> trail;  // newest last, at most kTrail
+  std::vector<double> trail_dt;        // the step each trail position came after, s (trail_dt[0] unused)
 };
 constexpr std::size_t kTrail = 4;
 
@@ -113,14 +114,16 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   int frame = 0, steps_done = 0;
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
   bool paused = false, stop = false, step_once = false, refactored = false, rebase = true, energy_noted = false;
+  bool problem_paused = false;  // paused by a problem, not by a page: reset goes on
   bool changed = true;  // the first step builds what the lab keeps (run.changed)
-  std::string problem;
+  std::string problem, problem_line;
+  Eigen::Matrix3Xd shown_x = state.x;  // the newest finite positions: what every page is sent
   double energy_start = 0.0, energy_limit = 0.0, energy_now = energy_of(state);
   StrainStats strain = strain_stats(state.x, scene.springs);
   Clock::time_point next_due = Clock::now();
 
   auto send_error = [&](int client, const std::string& line) {
-    std::fprintf(stderr, "%s\n", line.c_str());
+    live_log(line);  // a page that floods the run with bad messages gets its answers; stderr a summary
     server.send_text(client, nlohmann::json{{"type", "error"}, {"text", line}}.dump());
   };
   auto release = [&](std::map<int, Hold>::iterator hold) {
@@ -128,7 +131,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     state.inv_mass[p] = hold->second.inv_mass;
     const std::vector<Eigen::Vector3d>& trail = hold->second.trail;
     state.v.col(p).setZero();
-    if (trail.size() >= 2) state.v.col(p) = (trail.back() - trail.front()) / (dt_now() * double(trail.size() - 1));
+    double held_seconds = 0.0;  // the held steps' own dt: the knob may have changed since
+    for (std::size_t k = 1; k < hold->second.trail_dt.size(); ++k) held_seconds += hold->second.trail_dt[k];
+    if (trail.size() >= 2 && held_seconds > 0.0) state.v.col(p) = (trail.back() - trail.front()) / held_seconds;
     holds.erase(hold);
     changed = rebase = true;
     ++version;
@@ -147,6 +152,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
                                             {"energy_name", run.energy_name}, {"command", command_line()},
                                             {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}
                                  .dump());
+    if (!problem.empty()) {  // a page opened after the run stopped sees why (its frame follows: the last good one)
+      server.send_text(client, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
+    }
   };
 
   auto apply = [&](const LiveInbound& inbound) {
@@ -178,7 +186,10 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         break;
       case LiveCommandKind::kReset:
         state = start;
+        shown_x = state.x;
         holds.clear();
+        if (problem_paused) paused = false, next_due = Clock::now();  // "paused; reset to go on"
+        problem_paused = false;
         problem.clear();
         energy_noted = false;
         frame = 0, time = 0.0;
@@ -205,7 +216,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
             if (other->second.client == inbound.client) release(other);
             other = next;
           }
-          hold = holds.emplace(p, Hold{inbound.client, state.inv_mass[p], command.target, {}}).first;
+          hold = holds.emplace(p, Hold{inbound.client, state.inv_mass[p], command.target, {}, {}}).first;
           state.inv_mass[p] = 0.0;
           changed = true;
         }
@@ -244,7 +255,8 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       state.x.col(p) = hold.target;
       state.v.col(p).setZero();
       hold.trail.push_back(hold.target);
-      if (hold.trail.size() > kTrail) hold.trail.erase(hold.trail.begin());
+      hold.trail_dt.push_back(dt_now());
+      if (hold.trail.size() > kTrail) hold.trail.erase(hold.trail.begin()), hold.trail_dt.erase(hold.trail_dt.begin());
     }
     previous_step_seconds = last_step_seconds;
     last_step_seconds = (verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds()) + change_seconds;
@@ -267,17 +279,19 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         send_error(-1, "live: frame " + std::to_string(frame) + ": " + rose + " (reported; the run goes on)");
       }
     }
+    if (state.x.allFinite()) shown_x = state.x;
     if (!problem.empty()) {
-      paused = true;
-      const std::string line = "live: frame " + std::to_string(frame) + ": " + problem + " (paused; reset to go on)";
-      std::fprintf(stderr, "%s\n", line.c_str());
-      server.send_text(-1, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", line}}.dump());
+      paused = problem_paused = true;
+      problem_line = "live: frame " + std::to_string(frame) + ": " + problem + " (paused; reset to go on)";
+      live_log(problem_line);
+      server.send_text(-1, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
     }
     ++version;
   };
 
+  // A frame with a non-finite value is never sent: every page gets the last good positions (and a page
+  // that connects after a problem gets them too, with the problem in the status).
   auto send_frames = [&] {
-    if (!state.x.allFinite()) return;  // the last good frame stays on the page
     std::vector<float> data;
     std::string status;
     for (const int client : server.ready_clients()) {
@@ -286,9 +300,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         const std::size_t m = scene.springs.size();
         data.reserve(3 * static_cast<std::size_t>(n) + m);
         for (Eigen::Index p = 0; p < n; ++p) {
-          for (int a = 0; a < 3; ++a) data.push_back(static_cast<float>(state.x(a, p)));
+          for (int a = 0; a < 3; ++a) data.push_back(static_cast<float>(shown_x(a, p)));
         }
-        for (const Spring& spring : scene.springs) data.push_back(static_cast<float>(signed_strain(state.x, spring)));
+        for (const Spring& spring : scene.springs) data.push_back(static_cast<float>(signed_strain(shown_x, spring)));
         nlohmann::json values = nlohmann::json::object(), pinned = nlohmann::json::array(), held = nlohmann::json::array();
         nlohmann::json used = nlohmann::json::object();
         for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
@@ -325,9 +339,11 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       if (next_due < Clock::now() - std::chrono::milliseconds(100)) next_due = Clock::now();
     }
     send_frames();
+    live_log_flush();
     const double wait = paused ? 0.05 : std::chrono::duration<double>(next_due - Clock::now()).count();
     server.wait_inbound(std::min(std::max(wait, 0.0), 0.05));
   }
+  live_log_flush(true);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
   for (auto& [p, hold] : holds) state.inv_mass[p] = hold.inv_mass;

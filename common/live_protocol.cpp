@@ -108,8 +108,21 @@ LiveParse parse_live_message(const std::string& text, const Knobs& knobs, long l
     return refuse("a message of " + std::to_string(text.size()) + " bytes, over the cap of " +
                   std::to_string(kLiveMessageCap));
   }
-  const nlohmann::json message = nlohmann::json::parse(text, nullptr, false);
+  // A key given twice is refused: JSON parsers disagree on which one wins ({"cmd":"pause","cmd":"stop"}).
+  std::vector<std::set<std::string>> keys;
+  bool repeated = false;
+  const nlohmann::json::parser_callback_t watch = [&keys, &repeated](int, nlohmann::json::parse_event_t event,
+                                                                       nlohmann::json& parsed) {
+    if (event == nlohmann::json::parse_event_t::object_start) keys.emplace_back();
+    if (event == nlohmann::json::parse_event_t::object_end && !keys.empty()) keys.pop_back();
+    if (event == nlohmann::json::parse_event_t::key && !keys.empty() && !keys.back().insert(parsed.get<std::string>()).second) {
+      repeated = true;
+    }
+    return true;
+  };
+  const nlohmann::json message = nlohmann::json::parse(text, watch, false);
   if (message.is_discarded()) return refuse("malformed JSON");
+  if (repeated) return refuse("a key given twice");
   if (!message.is_object()) return refuse("a message is a JSON object with \"cmd\"");
   const auto cmd = message.find("cmd");
   if (cmd == message.end() || !cmd->is_string()) return refuse("no \"cmd\" string");
@@ -156,6 +169,7 @@ LiveParse parse_live_message(const std::string& text, const Knobs& knobs, long l
       } else if (problem.empty() && declared.integer && std::floor(command.value) != command.value) {
         problem = knob + ": " + live_number_text(command.value) + " is not an integer";
       }
+      command.value += 0.0;  // -0 is 0
       break;
     }
     case LiveCommandKind::kDrag: {

@@ -1,23 +1,32 @@
 #pragma once
-// The live mode's server (docs/DESIGN.md §3, "The live mode"): civetweb's
-// HTTP and WebSocket server on 127.0.0.1 only. GET /?token=T serves the page,
-// /ws?token=T is the page's WebSocket; neither answers without the run's
-// token, and a WebSocket whose Origin is not this server's is refused. The
-// live loop (common/live.h) reads the messages in its own thread; civetweb's
-// threads only queue them.
+// The live mode's server (docs/DESIGN.md §3, "The live mode"): a small HTTP
+// and WebSocket (RFC 6455) server on 127.0.0.1 only, one thread with
+// non-blocking sockets and poll(). GET /?token=T serves the page, /ws?token=T
+// is the page's WebSocket; neither answers without the run's token (403), and
+// a WebSocket whose Origin is not this server's is refused (403).
+//
+// One slow or noisy client must never stall the run or another client, so:
+// the live loop (common/live.h) never touches a socket (it fills per-client
+// outboxes; a frame waiting replaces the one before, the newest wins); a
+// client whose outbox does not drain for kStalledSeconds, or whose text
+// waiting passes kOutboxBytes, is dropped with one line; each client's
+// messages wait in its own queue of at most kInboundPerClient, and while it is
+// full the server reads no more from that client (TCP holds the rest, so
+// nothing is lost, an ack included); take_inbound takes from every client in
+// turn. A frame is refused by the length its header declares, before its
+// payload is read (the payload is discarded as it comes); binary messages are
+// refused, fragmented text messages assembled. Connections are bounded:
+// kMaxClients WebSockets (a new one evicts the one heard from least
+// recently), kMaxPending connections still sending their request (a new one
+// evicts the oldest), each given kRequestSeconds to send it.
+#include <array>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "common/live_protocol.h"
-
-struct mg_context;
-struct mg_connection;
 
 namespace cl {
 
@@ -34,7 +43,7 @@ class LiveServer {
   // Listens on 127.0.0.1:port (0: a free port) and serves `page` (HTML) at
   // "/". Throws InputError when it cannot listen (the port in use).
   LiveServer(int port, std::string page);
-  ~LiveServer();  // closes every connection and stops civetweb's threads
+  ~LiveServer();  // closes every connection and stops the server's thread
   LiveServer(const LiveServer&) = delete;
   LiveServer& operator=(const LiveServer&) = delete;
 
@@ -42,52 +51,43 @@ class LiveServer {
   const std::string& token() const { return token_; }
   std::string url() const;  // http://127.0.0.1:PORT/?token=T
 
-  // The messages and closings since the last call, oldest first.
+  // The messages, openings and closings since the last call: at most
+  // kTakePerClient of each client's, the clients in turn, each client's in order.
   std::vector<LiveInbound> take_inbound();
   // Waits up to `seconds` for an inbound message (returns at once if one is queued).
   void wait_inbound(double seconds);
 
-  // A text message to one client (client < 0: to every client).
+  // A text message to one client (client < 0: to every client). Never blocks.
   void send_text(int client, const std::string& text);
   // The clients ready for a frame: fewer than kFramesInFlight frames sent and
   // not acknowledged ({"cmd": "ack"}, acknowledge()).
   std::vector<int> ready_clients();
-  // A binary message (a frame) to `client`, counted as in flight.
+  // A frame (its status text, then its binary data) to `client`, counted as in
+  // flight; replaces a frame of the client's still waiting. Never blocks.
   void send_frame(int client, const std::string& text, const std::vector<float>& frame);
   void acknowledge(int client);
   int clients();
 
   static constexpr int kFramesInFlight = 2;
-  static constexpr std::size_t kLiveInboundCap = kLiveMessageCap + 1;  // enough to refuse by size
-  static constexpr std::size_t kInboundQueueCap = 1024;  // messages waiting for the loop
+  static constexpr int kMaxClients = 16;
+  static constexpr int kMaxPending = 32;
+  static constexpr double kRequestSeconds = 3.0;
+  static constexpr std::size_t kRequestCap = 8192;  // bytes of a request's head
+  static constexpr std::size_t kInboundPerClient = 64;
+  static constexpr std::size_t kTakePerClient = 32;
+  static constexpr std::size_t kOutboxBytes = std::size_t{1} << 20;
+  static constexpr double kStalledSeconds = 5.0;
+  static constexpr double kPingSeconds = 2.0;
+  static constexpr double kSilentSeconds = 20.0;  // a WebSocket that answers nothing, not even a ping
 
-  // civetweb's callbacks (public for the C trampolines in live_server.cpp).
-  int on_request(mg_connection* connection);
-  int on_connect(const mg_connection* connection);
-  void on_ready(mg_connection* connection);
-  int on_data(mg_connection* connection, int bits, char* data, std::size_t length);
-  void on_close(const mg_connection* connection);
+  struct Shared;  // the queues both threads touch (live_server.cpp)
+  struct Loop;    // the server thread's own state
 
  private:
-  struct Client {
-    mg_connection* connection;
-    int in_flight = 0;
-  };
-  bool token_ok(const char* query) const;
-  void refuse_line(const std::string& line);
-  void push(LiveInbound inbound);
-
-  std::string page_;
   std::string token_;
   int port_ = 0;
-  mg_context* context_ = nullptr;
-  std::mutex mutex_;  // clients_, inbound_, next_client_
-  std::map<int, Client> clients_;
-  std::map<const mg_connection*, int> ids_;
-  std::deque<LiveInbound> inbound_;
-  int next_client_ = 1;
-  struct Wake;
-  std::unique_ptr<Wake> wake_;
+  std::unique_ptr<Shared> shared_;
+  std::unique_ptr<Loop> loop_;
 };
 
 // 128 random bits as 32 hex digits (std::random_device).
@@ -100,5 +100,32 @@ bool live_origin_allowed(const char* origin, int port);
 
 // Whether `query` (a request's query string; null: none) carries token=`token`.
 bool live_token_matches(const char* query, const std::string& token);
+
+// One line to stderr, at most kLiveLogPerSecond a second from the whole
+// program: the rest are counted, and live_log_flush() (or the next line once
+// the second is over) prints "live: N more lines like these ... not shown".
+constexpr int kLiveLogPerSecond = 10;
+void live_log(const std::string& line);
+void live_log_flush(bool final = false);  // final: the summary now, whatever the time
+
+// The WebSocket wire format (RFC 6455), pure functions for the unit tests.
+// A frame's header at the front of `data`: complete false when more bytes are
+// needed; `bad` when it is one no client may send (reserved bits, a control
+// frame that is fragmented or longer than 125 bytes, a length with its top bit set).
+struct WebSocketHeader {
+  bool complete = false;
+  bool bad = false;
+  bool fin = false;
+  int opcode = 0;
+  bool masked = false;
+  std::uint64_t length = 0;  // the payload's, as declared
+  std::size_t size = 0;      // the header's own bytes
+  std::array<unsigned char, 4> mask{};
+};
+WebSocketHeader parse_websocket_header(const char* data, std::size_t size);
+// A server's (unmasked, final) frame of `opcode` around `payload`.
+std::string websocket_frame(int opcode, const char* payload, std::size_t size);
+// Sec-WebSocket-Accept for a client's Sec-WebSocket-Key: base64(SHA-1(key + GUID)).
+std::string websocket_accept(const std::string& key);
 
 }  // namespace cl

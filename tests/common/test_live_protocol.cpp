@@ -3,6 +3,7 @@
 // leaves the command empty; every accepted message carries its values.
 #include <catch2/catch.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -75,6 +76,14 @@ TEST_CASE("live protocol refuses malformed JSON, a non-object and an unknown com
   require_refused(R"({"cmd": "drag", "particle": 3})", "missing \"x\"");
   require_refused(R"({"cmd": "line\nbreak"})", "unknown command 'line?break'");  // still one line
   require_refused(R"({"cmd": "pause", "a\u0000b": 1})", "unknown key 'a?b'");
+}
+
+TEST_CASE("live protocol refuses a key given twice and reads -0 as 0", "[live]") {
+  require_refused(R"({"cmd": "pause", "cmd": "stop"})", "a key given twice");
+  require_refused(R"({"cmd": "set", "knob": "K", "value": 3, "value": 4})", "a key given twice");
+  const cl::LiveCommand zero = accepted(R"({"cmd": "set", "knob": "K", "value": -0.0})");
+  CHECK(zero.value == 0.0);
+  CHECK_FALSE(std::signbit(zero.value));
 }
 
 TEST_CASE("live protocol refuses a knob out of its range, unknown or fractional for an integer knob", "[live]") {

@@ -32,22 +32,53 @@ def live_command(argv):
     solution = token.endswith("_solution")
     lab = resolve_lab(token.removesuffix("_solution"))
     port = []
-    if "--port" in rest:
-        at = rest.index("--port")
-        if at + 1 >= len(rest):
-            raise CourseError("live: --port needs a number (1 … 65535)", code=2)
-        port = [rest[at + 1]]
-        del rest[at:at + 2]
+    for at, word in enumerate(rest):
+        if word == "--port" or word.startswith("--port="):
+            value = word[len("--port="):] if "=" in word else (rest[at + 1] if at + 1 < len(rest) else "")
+            if not value.isdigit() or not 1 <= int(value) <= 65535:
+                raise CourseError(f"live: --port needs a number in [1, 65535], not {value!r}", code=2)
+            port = [value]
+            del rest[at:at + (1 if "=" in word else 2)]
+            break
     name = lab + ("_solution" if solution else "")
     return name, [name, "--live", *port, *rest]
+
+
+def read_url(process, seconds):
+    """(port, token) from the live program's first line, waiting at most `seconds`: a program that
+    hangs before it, ends, or prints something else raises RuntimeError (one line)."""
+    import threading
+    lines = []
+    reader = threading.Thread(target=lambda: lines.append(process.stdout.readline()), daemon=True)
+    reader.start()
+    reader.join(seconds)
+    if not lines:
+        raise RuntimeError(f"the program printed no URL within {seconds:.0f} s")
+    match = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32})", lines[0].strip())
+    if not match:
+        said = lines[0].strip()
+        if not said:
+            try:
+                said = f"nothing (exit {process.wait(timeout=5)})"
+            except subprocess.TimeoutExpired:
+                said = "nothing"
+        raise RuntimeError(f"the program's first line is {said[:200]!r}, not its URL")
+    return match.groups()
 
 
 def bench(program, args):
     """Latency (s, median of 50 drags) and frames per second of `program --live ARGS`."""
     import websocket  # Debian's python3-websocket
-    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, text=True)
+    import tempfile
+    errors = tempfile.TemporaryFile(mode="w+")
+    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, stderr=errors, text=True)
     try:
-        port, token = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=(\w+)", process.stdout.readline().strip()).groups()
+        try:
+            port, token = read_url(process, 30)
+        except RuntimeError as error:
+            errors.seek(0)
+            said = [line for line in errors.read().splitlines() if line.strip()]
+            raise CourseError(f"live --bench: {said[-1] if said else error}", code=2) from None
         client = websocket.create_connection(f"ws://127.0.0.1:{port}/ws?token={token}", timeout=10)
         hello = json.loads(client.recv())
         n = hello["particles"]
@@ -69,7 +100,9 @@ def bench(program, args):
             frames += 1
         rate, steps = frames / (time.monotonic() - start), (last["frame"] - first) / (time.monotonic() - start)
         client.send('{"cmd": "speed", "value": 1}')
-        particle, latencies = n - 1, []
+        pinned = set(next_status()["pinned"])
+        particle = max(p for p in range(n) if p not in pinned)  # the last free particle
+        latencies = []
         for k in range(50):
             target = [0.01 * (k % 5), -0.5 - 0.01 * k, 0.05]
             sent = time.monotonic()
@@ -83,10 +116,13 @@ def bench(program, args):
         client.send('{"cmd": "stop"}')
         process.wait(timeout=10)
         return statistics.median(latencies), rate, steps, n
+    except (OSError, websocket.WebSocketException, subprocess.TimeoutExpired, ValueError, KeyError) as error:
+        raise CourseError(f"live --bench: {type(error).__name__}: {error}", code=2) from None
     finally:
         if process.poll() is None:
             process.kill()
             process.wait()
+        errors.close()
 
 
 def cmd_live(argv):

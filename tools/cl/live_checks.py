@@ -11,17 +11,20 @@ the token and of a foreign Origin, and the page's stop (exit 0, the summary
 with the new K)."""
 import json
 import math
-import re
 import os
 import shutil
 import signal
 import subprocess
+import threading
 import time
 import urllib.error
 import urllib.request
 from pathlib import Path
 
 from .base import BIN, BUILD
+from .live import read_url
+from .live_handouts import check_handouts
+from .live_stress import FLOOD, check_stress
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
                   "--enable-unsafe-swiftshader", "--window-size=800,600", "--remote-debugging-port=0",
@@ -113,8 +116,11 @@ def refusal_problems(port, token):
         websocket.create_connection(f"ws://127.0.0.1:{port}/ws?token={token}", timeout=5,
                                     origin="http://evil.example").close()
         problems.append("a WebSocket from Origin http://evil.example was accepted")
-    except (websocket.WebSocketException, OSError):
-        pass
+    except websocket.WebSocketBadStatusException as error:
+        if error.status_code != 403:
+            problems.append(f"a WebSocket from a foreign Origin: HTTP {error.status_code}, not 403")
+    except (websocket.WebSocketException, OSError) as error:
+        problems.append(f"a WebSocket from a foreign Origin: {error}, not HTTP 403")
     return problems
 
 
@@ -252,17 +258,31 @@ def check_live(checks):
     scratch.mkdir(parents=True)
     summary = scratch / "summary.json"
     started = time.monotonic()
+    # The stress test runs beside the browser's, on a program of its own: the two share the 20 s.
+    stress = {}
+
+    def beside():  # the stress, then the handouts' live sections (each a program of its own)
+        try:
+            stress.update(zip(("problems", "numbers"), check_stress(program)))
+        except Exception as error:  # noqa: BLE001 (a thread's error is a check's problem, not a lost traceback)
+            stress["problems"] = [f"the stress test: {type(error).__name__}: {error}"]
+        handouts_started = time.monotonic()
+        try:
+            stress["handouts"] = check_handouts()
+        except Exception as error:  # noqa: BLE001
+            stress["handouts"] = [f"the handouts' live checks: {type(error).__name__}: {error}"]
+        stress["handouts_seconds"] = time.monotonic() - handouts_started
+
+    stressing = threading.Thread(target=beside)
+    stressing.start()
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live", "--summary", str(summary)],
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     problems, browser, page = [], None, None
     profile = scratch / "chromium-profile"
     try:
-        url = process.stdout.readline().strip()
-        match = re.fullmatch(r"http://127\.0\.0\.1:(\d+)/\?token=([0-9a-f]{32})", url)
-        if not match:
-            raise RuntimeError(f"the first line is {url!r}, not http://127.0.0.1:PORT/?token=...")
-        browser, page = start_chromium(chromium, url, profile)
-        problems += drive(page, process, *match.groups())
+        port, token = read_url(process, 20)
+        browser, page = start_chromium(chromium, f"http://127.0.0.1:{port}/?token={token}", profile)
+        problems += drive(page, process, port, token)
         code = process.wait(timeout=10)
         if code != 0:
             problems.append(f"after the page's stop the program exited {code}, not 0")
@@ -292,3 +312,19 @@ def check_live(checks):
                   "a drag of 0.2 m held (and marked) and followed, a shift-click pin, reset, K turned in the page, a "
                   "malformed message refused while frames kept coming, a second client gone mid-drag, no token and a foreign Origin refused, stop: exit 0",
                   problems)
+    stressing.join(timeout=120)
+    numbers = stress.get("numbers", {})
+    checks.record(not stressing.is_alive() and not stress.get("problems", ["the stress test did not finish"]),
+                  "live under stress, beside it: 3 clients that ack and never read (dropped after "
+                  f"{numbers.get('ackers_dropped_after')} s), a flood of "
+                  f"{FLOOD} refused messages ({numbers.get('flood_answered')} answered), 50 sockets held and a 100 MB "
+                  f"message, while an honest client got {numbers.get('honest_fps')} frames/s (median, at least 20) "
+                  f"and {numbers.get('honest_answered')} answers; the page in {numbers.get('page_seconds', 0):.2f} s, "
+                  f"a new WebSocket greeted in {numbers.get('hello_seconds', 0):.2f} s (at most 2); RSS "
+                  f"+{numbers.get('rss_rise_mb', 0):.1f} MB for the 100 MB message (under 10); SIGTERM "
+                  f"{numbers.get('sigterm_seconds', 0):.2f} s; {numbers.get('stderr_lines')} stderr lines",
+                  stress.get("problems", ["the stress test did not finish within 60 s"]))
+    checks.record("handouts" in stress and not stress["handouts"],
+                  f"live: the handouts' \"Try it live\" numbers and effects (labs 04, 06, 14) on the reference, driven "
+                  f"over the page's socket ({stress.get('handouts_seconds', 0):.0f} s)",
+                  stress.get("handouts", ["the handouts' live checks did not finish"]))
