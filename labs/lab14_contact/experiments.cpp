@@ -72,9 +72,9 @@ int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOp
                    "--drape writes drape.csv, not one run's summary");
   if (lab.friction) throw InputError("--friction: --drape sweeps --frictions instead");
   Scene loaded = load_scene_for(options, scene_dir);
+  start_run(options);  // --check stops here, before the initial penetration pass runs your code
   const InitialPenetration initial = resolve_initial_penetration(loaded.particles, loaded.colliders);
   if (initial.particles > 0) report_initial_penetration(lab_name, initial);
-  start_run(options);
   double mass = 0.0;
   for (Eigen::Index i = 0; i < loaded.particles.size(); ++i) {
     if (loaded.particles.inv_mass[i] > 0.0) mass += 1.0 / loaded.particles.inv_mass[i];

@@ -49,12 +49,13 @@ int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene&
 
 int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
+  const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
+  // --check stops here: the initial penetration pass below runs your surface_distance.
+  if (live.on) cl::stop_if_checking(); else cl::start_run(options);
   const cl::lab14::InitialPenetration initial = cl::lab14::resolve_initial_penetration(scene.particles,
                                                                                        scene.colliders);
   if (initial.particles > 0) cl::lab14::report_initial_penetration(kLab, initial);
   if (live.on) return run_live(options, lab, scene);
-  cl::start_run(options);
-  const cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
   cl::lab14::ContactStepper stepper(scene, settings);
   cl::FrameOutput output =
       cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab14::step_columns(), options.method);

@@ -161,7 +161,7 @@ Outcome run_modes(std::vector<std::string> arguments) {
 }
 }  // namespace
 
-TEST_CASE("--check loads the scene, says what would run and stops where the run starts", "[common][cli]") {
+TEST_CASE("the check flag loads the scene, says what would run and stops where the run starts", "[common][cli]") {
   const std::filesystem::path folder =
       std::filesystem::temp_directory_path() / ("cl-check-" + std::to_string(::getpid()));
   std::filesystem::remove_all(folder);
@@ -214,7 +214,7 @@ TEST_CASE("run_main maps each outcome to its exit code", "[common][cli]") {
   CHECK(run_with({}, []() -> int { throw std::runtime_error("boom"); }) == 1);
 }
 
-TEST_CASE("--dt and --steps hold the scene's ranges", "[common][cli][limits]") {
+TEST_CASE("the dt and steps flags hold the scene's ranges", "[common][cli][limits]") {
   std::ostringstream captured;
   std::streambuf* const saved = std::cerr.rdbuf(captured.rdbuf());
   const int huge = run_with({"--dt", "1e300"}, [] { return 0; });
