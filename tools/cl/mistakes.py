@@ -134,7 +134,7 @@ def plant_all(lab, entries, every_case, log):
             problem = f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
         else:
             write_if_changed(TREE / "labs" / lab / entry["file"], reference.replace(entry["find"], entry["replace"]))
-            built, errors = build([f"{lab}_tests", lab])
+            built, errors = build([f"{lab}_tests", *([lab] if entry.get("symptom") else [])])
             if not built:
                 problem = "the planted file does not build: " + " | ".join(errors)
             else:
