@@ -113,7 +113,8 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   long version = 0;            // the state's, +1 at every change the page should see
   int frame = 0, steps_done = 0;
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
-  bool paused = false, stop = false, step_once = false, refactored = false, rebase = true, energy_noted = false;
+  bool paused = false, stop = false, step_once = false, rebase = true, energy_noted = false;
+  std::string rebuilt;  // what the lab rebuilt before the last step ("": nothing)
   bool problem_paused = false;  // paused by a problem, not by a page: reset goes on
   bool changed = true;  // the first step builds what the lab keeps (run.changed)
   std::string problem, problem_line;
@@ -245,7 +246,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
 
   auto step = [&] {
     const Timer change_timer;
-    if (changed && run.changed) run.changed(knobs), refactored = true;
+    if (changed && run.changed) rebuilt = run.changed(knobs);
     changed = false;
     const double change_seconds = change_timer.seconds();  // a refactorization: the page says this step cost more
     const Timer timer;
@@ -315,7 +316,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         }
         const double shown_energy = std::isfinite(energy_now) ? energy_now : 0.0;
         status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
-                                {"previous_step_seconds", previous_step_seconds}, {"refactored", refactored},
+                                {"previous_step_seconds", previous_step_seconds}, {"refactored", !rebuilt.empty()}, {"rebuilt", rebuilt},
                                 {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
                                 {"paused", paused}, {"speed", speed}, {"knobs", values}, {"step_knobs", used}, {"pinned", pinned},
                                 {"held", held}, {"problem", problem}, {"clients", server.clients()}}
@@ -332,7 +333,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     const Clock::time_point now = Clock::now();
     if (step_once || (!paused && problem.empty() && now >= next_due)) {
       step_once = false;
-      refactored = false;
+      rebuilt.clear();
       step();
       const auto period = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(dt_now() / speed));
       next_due += period;

@@ -10,6 +10,9 @@
 #include <functional>
 #include <string>
 #include <utility>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "common/cli.h"
 #include "common/frame_loop.h"
@@ -27,6 +30,26 @@ struct LiveOptions {
 void add_live_option(CommandLine& line, LiveOptions& live);
 
 // What a lab gives the live loop.
+// What a lab built its solver for in live mode: the inverse masses (pins and
+// held particles) and the knobs the solver depends on. A `changed` hook
+// rebuilds only when update() says these differ from the last build, so that
+// turning a knob the solver does not depend on (K) rebuilds nothing.
+class BuiltFor {
+ public:
+  bool update(const Eigen::VectorXd& inv_mass, std::vector<double> values) {
+    if (built_ && inv_mass_.size() == inv_mass.size() && inv_mass_ == inv_mass && values_ == values) return false;
+    built_ = true;
+    inv_mass_ = inv_mass;
+    values_ = std::move(values);
+    return true;
+  }
+
+ private:
+  bool built_ = false;
+  Eigen::VectorXd inv_mass_;
+  std::vector<double> values_;
+};
+
 struct LiveRun {
   LiveRun(std::string lab_name, std::string method_name, Knobs declared)
       : lab(std::move(lab_name)), method(std::move(method_name)), knobs(std::move(declared)) {}
@@ -39,9 +62,11 @@ struct LiveRun {
   // inverse masses say what is pinned or held: read them every step).
   std::function<StepVerdict(const Knobs&)> step;
   // Called before the first step and before the step that follows a change of
-  // a knob, a pin or a held particle (lab 06 refactors there: that step's time
-  // includes it, and its status says so). Optional.
-  std::function<void(const Knobs&)> changed;
+  // a knob, a pin or a held particle; it rebuilds what the lab keeps if what
+  // that was built for changed (BuiltFor below) and returns what it rebuilt
+  // ("A, factored again"), or "" when nothing needed it. The status of that
+  // step says so, and its time includes the rebuild. Optional.
+  std::function<std::string(const Knobs&)> changed;
   // The energy the verdict watches, J; unset: kinetic + potential in the scene's gravity.
   std::function<double(const Particles&)> energy;
   std::string energy_name = "kinetic + potential energy";

@@ -190,5 +190,7 @@ int main(int argc, char** argv) {
   app.add_option("--energy-seconds", lab.energy_seconds, "sweeps: compare the total energy at this time")
       .finite_in(0.0, 1e9)
       .capture_default_str();
+  app.modes({{"--sweep-iterations", {"--sweep-scenes", "--settle-tolerance", "--energy-seconds"}},
+             {"--sweep-substeps", {"--sweep-scenes", "--settle-tolerance", "--energy-seconds", "--cost"}}}, {});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -172,5 +172,6 @@ int main(int argc, char** argv) {
   app.add_option("--map-seconds", lab.map_seconds, "simulated time per --stability-map run (s)")
       .finite_in(1e-9, 1e6)
       .capture_default_str();
+  app.modes({{"--stability-map", {"--map-stiffness", "--map-dt", "--map-seconds"}}, {"--compare-limits", {}}}, {});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

@@ -59,9 +59,12 @@ int run_steps(const cl::CommonOptions& options, const LabOptions& lab) {
                                            {"dt", "s", 1e-4, 0.05, scene.dt}, {"k", "N/m", 1, 1e6, k}}};
     std::vector<cl::Spring> springs = scene.springs;
     std::optional<cl::lab06::Solver> live_solver;
-    run.changed = [&](const cl::Knobs& knobs) {
+    cl::BuiltFor built;  // A depends on the masses (pins, held particles), dt and k; not on K
+    run.changed = [&](const cl::Knobs& knobs) -> std::string {
+      if (!built.update(scene.particles.inv_mass, {knobs[1], knobs[2]})) return "";
       for (cl::Spring& spring : springs) spring.stiffness = knobs[2];
       live_solver.emplace(cl::lab06::make_problem(scene.particles.inv_mass, springs, knobs[1]), method);
+      return "A, factored again";
     };
     run.step = [&](const cl::Knobs& knobs) {
       settings.iterations = knobs.integer(0);

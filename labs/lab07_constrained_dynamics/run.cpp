@@ -28,12 +28,15 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   settings.regularization = lab.regularize;
   MovableMap map;
   Eigen::VectorXd lambda;  // the last step's multipliers (the springs' elastic energy)
-  run.changed = [&](const Knobs& knobs) {
+  BuiltFor built;  // the unknowns' map and the multipliers depend on the masses (pins, held particles) and k
+  run.changed = [&](const Knobs& knobs) -> std::string {
+    if (!built.update(scene.particles.inv_mass, {finite ? knobs[2] : 0.0})) return "";
     map = make_movable_map(scene.particles.inv_mass);  // a pin or a held particle is no longer an unknown
     if (finite) {
       for (Spring& spring : scene.springs) spring.stiffness = knobs[2];
     }
     lambda.resize(0);
+    return "the unknowns' map and the multipliers";
   };
   run.step = [&](const Knobs& knobs) -> StepVerdict {
     settings.dt = knobs[0];

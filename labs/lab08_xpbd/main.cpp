@@ -50,8 +50,9 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                                            {"dt", "s", 1e-4, 0.05, scene.dt}, {"k", "N/m", 1, 1e8, k0}}};
     cl::lab04::ConstraintSet springs = constraints;
     Eigen::VectorXd lambda;
-    run.changed = [&](const cl::Knobs& knobs) {
+    run.changed = [&](const cl::Knobs& knobs) -> std::string {  // XPBD keeps no matrix: nothing is rebuilt
       for (cl::Spring& spring : springs.springs) spring.stiffness = knobs[2] != k0 ? knobs[2] : spring.stiffness;
+      return "";
     };
     run.step = [&](const cl::Knobs& knobs) {
       cl::lab08::FrameSettings frame = settings;
@@ -177,5 +178,6 @@ int main(int argc, char** argv) {
                  "relative spread (0: run all --steps frames)")
       .finite_in(0.0, 1e9)
       .capture_default_str();
+  app.modes({{"--sweep-iterations", {"--settle-tolerance"}}}, {});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

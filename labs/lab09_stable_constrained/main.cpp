@@ -193,5 +193,6 @@ int main(int argc, char** argv) {
   app.add_option("--sweep-links", lab.sweep_links, "experiment: links in the chain")
       .range(2, 10000)
       .capture_default_str();
+  app.modes({{"--sweep-mass-ratios", {"--sweep-dt-min", "--sweep-dt-max", "--sweep-per-decade", "--sweep-links"}}}, {});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

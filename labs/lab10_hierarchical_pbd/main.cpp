@@ -54,9 +54,12 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
                      {"dt", "s", 1e-4, 0.05, scene.dt}, {"levels", "", 1, 1.0 * most, 1.0 * lab.levels, true}}};
     const Eigen::Matrix3Xd rest = scene.particles.x;  // the coarse levels' rest lengths
     std::optional<cl::ClothHierarchy> live_hierarchy;
-    run.changed = [&](const cl::Knobs& knobs) {
+    cl::BuiltFor built;  // the hierarchy depends on the masses (pins, held particles) and the levels
+    run.changed = [&](const cl::Knobs& knobs) -> std::string {
+      if (!built.update(scene.particles.inv_mass, {knobs[2]})) return "";
       live_hierarchy.emplace(cl::build_cloth_hierarchy(scene.grid_nx, scene.grid_ny, rest, scene.particles.inv_mass,
                                                        scene.springs, knobs.integer(2)));
+      return "the hierarchy";
     };
     run.step = [&](const cl::Knobs& knobs) {
       settings.iterations.assign(static_cast<std::size_t>(knobs.integer(2)), knobs.integer(0));
@@ -181,5 +184,6 @@ int main(int argc, char** argv) {
                  "--converge: also stop once the cloth sweeps alone reach this many projections (0: no limit)")
       .finite_in(0.0, 1e15)
       .capture_default_str();
+  app.modes({{"--converge", {"--sweep-scenes", "--sweep-levels", "--targets", "--max-sweeps", "--max-projections"}}}, {});
   return cl::run_main(app, argc, argv, [&] { return run(options, lab); });
 }

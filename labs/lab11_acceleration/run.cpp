@@ -54,7 +54,12 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   if (chebyshev) declared.push_back({"rho", "", 0, 0.9999, settings.rho});
   if (method == Method::kPdLbfgs) declared.push_back({"history", "pairs", 0, 50, 1.0 * settings.history, true});
   LiveRun run{lab_name, options.method, Knobs(declared)};
-  run.changed = [&](const Knobs& knobs) { solver.emplace(scene.particles.inv_mass, scene.springs, knobs[1]); };
+  BuiltFor built;  // A depends on the masses (pins, held particles) and dt
+  run.changed = [&](const Knobs& knobs) -> std::string {
+    if (!built.update(scene.particles.inv_mass, {knobs[1]})) return "";
+    solver.emplace(scene.particles.inv_mass, scene.springs, knobs[1]);
+    return "A, factored again";
+  };
   run.step = [&](const Knobs& knobs) {
     settings.iterations = knobs.integer(0);
     if (chebyshev) settings.rho = knobs[2];

@@ -37,9 +37,12 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
                              {"dt", "s", 1e-4, 0.05, scene.dt}, {"k", "N/m", 1, 1e10, k}};
   if (method == Method::kVbdChebyshev) declared.push_back({"rho", "", 0, 0.9999, settings.rho});
   LiveRun run{lab_name, options.method, Knobs(declared)};
-  run.changed = [&](const Knobs& knobs) {
+  BuiltFor built;  // the solver (colours, adjacency) depends on the masses (pins, held particles), dt and k
+  run.changed = [&](const Knobs& knobs) -> std::string {
+    if (!built.update(scene.particles.inv_mass, {knobs[1], knobs[2]})) return "";
     for (Spring& spring : scene.springs) spring.stiffness = knobs[2];
     solver.emplace(scene.particles.inv_mass, scene.springs, knobs[1]);
+    return "the solver (its colouring)";
   };
   run.step = [&](const Knobs& knobs) {
     settings.iterations = knobs.integer(0);

@@ -55,17 +55,10 @@ int run_live_scene(const char* lab_name, const CommonOptions& options, const Lab
   // What the solver was built for: the masses (pins and held particles), Δt
   // and k. K alone changes none of it, so turning K keeps the solver, its
   // factor's analysis and a hard set's warm multipliers.
-  Eigen::VectorXd built_inv_mass;
-  double built_dt = 0.0, built_k = 0.0;
-  run.changed = [&](const Knobs& knobs) {
+  BuiltFor built;
+  run.changed = [&](const Knobs& knobs) -> std::string {
     const double k = finite ? knobs[2] : 0.0;
-    if (built_inv_mass.size() != 0 && built_inv_mass == scene.particles.inv_mass && built_dt == knobs[1] &&
-        built_k == k) {
-      return;
-    }
-    built_inv_mass = scene.particles.inv_mass;
-    built_dt = knobs[1];
-    built_k = k;
+    if (!built.update(scene.particles.inv_mass, {knobs[1], k})) return "";
     if (finite) {
       for (Spring& spring : springs) spring.stiffness = k;
     }
@@ -75,6 +68,7 @@ int run_live_scene(const char* lab_name, const CommonOptions& options, const Lab
       lab06_solver.emplace(lab06::make_problem(scene.particles.inv_mass, springs, knobs[1]),
                            lab06_method(options.method));
     }
+    return constrained ? "the solver (its matrix's pattern and analysis)" : "lab 06's solver";
   };
   run.step = [&](const Knobs& knobs) {
     if (!constrained) {

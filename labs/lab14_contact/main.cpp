@@ -34,11 +34,12 @@ int run_live(const cl::CommonOptions& options, const LabOptions& lab, cl::Scene&
                                          {"dt", "s", 1e-4, 0.05, scene.dt}, {"mu", "", 0, 2, mu}}};
   cl::lab14::StepSettings settings = cl::lab14::step_settings(scene, options, lab);
   std::optional<cl::lab14::ContactStepper> stepper;
-  run.changed = [&](const cl::Knobs& knobs) {
+  run.changed = [&](const cl::Knobs& knobs) -> std::string {  // the stepper holds K, dt and mu: built again
     settings.iterations = knobs.integer(0);
     settings.dt = knobs[1];
     settings.friction = knobs[2];
     stepper.emplace(scene, settings);
+    return "the contact stepper";
   };
   run.step = [&](const cl::Knobs&) {
     const cl::lab14::StepReport report = stepper->step(scene.particles);

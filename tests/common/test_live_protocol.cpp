@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "common/live.h"
 #include "common/live_protocol.h"
 #include "common/live_server.h"
 
@@ -184,4 +185,17 @@ TEST_CASE("live protocol replays the fuzzer's saved inputs", "[live]") {
     ++replayed;
   }
   CHECK(replayed >= 1);  // the folder holds at least its seed
+}
+
+TEST_CASE("a live lab rebuilds only when what its solver was built for changed", "[common][live]") {
+  cl::BuiltFor built;
+  Eigen::VectorXd inv_mass = Eigen::VectorXd::Ones(3);
+  CHECK(built.update(inv_mass, {0.01, 1e3}));        // the first build
+  CHECK_FALSE(built.update(inv_mass, {0.01, 1e3}));  // K turned: dt and k as built
+  CHECK(built.update(inv_mass, {0.02, 1e3}));        // dt
+  CHECK(built.update(inv_mass, {0.02, 1e4}));        // k
+  inv_mass[1] = 0.0;                                 // a pin or a held particle
+  CHECK(built.update(inv_mass, {0.02, 1e4}));
+  CHECK_FALSE(built.update(inv_mass, {0.02, 1e4}));
+  CHECK(built.update(Eigen::VectorXd::Ones(4), {0.02, 1e4}));  // another size: never compared entrywise
 }
