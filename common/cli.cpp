@@ -384,6 +384,7 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
   if (!words.empty()) words[0] = program.c_str();
   set_command_line(argc, words.data());
   bool check = false;
+  loaded_scenes.clear();  // one run's scenes (a test calls run_main many times in one process)
   if (app.get_option_no_throw("--check") == nullptr) {
     app.add_flag("--check", check,
                  "check the flags and the scene as a run would, print what would run, and stop (nothing written)");

@@ -115,6 +115,10 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   double time = 0.0, seconds = 0.0, last_step_seconds = 0.0, previous_step_seconds = 0.0, speed = 1.0;
   bool paused = false, stop = false, step_once = false, rebase = true, energy_noted = false;
   std::string rebuilt;  // what the lab rebuilt before the last step ("": nothing)
+  // The last rebuild, kept in every status: a page behind (a frame replaced by
+  // a newer one in its outbox) still learns that a change rebuilt something.
+  std::string last_rebuilt;
+  int last_rebuilt_frame = -1;
   bool problem_paused = false;  // paused by a problem, not by a page: reset goes on
   bool changed = true;  // the first step builds what the lab keeps (run.changed)
   std::string problem, problem_line;
@@ -263,6 +267,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     last_step_seconds = (verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds()) + change_seconds;
     seconds += last_step_seconds;
     if (verdict.taken) ++frame, ++steps_done, time += dt_now();
+    if (!rebuilt.empty()) last_rebuilt = rebuilt, last_rebuilt_frame = frame;
     strain = strain_stats(state.x, scene.springs);
     energy_now = energy_of(state);
     problem = verdict.problem;
@@ -317,6 +322,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
         const double shown_energy = std::isfinite(energy_now) ? energy_now : 0.0;
         status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
                                 {"previous_step_seconds", previous_step_seconds}, {"refactored", !rebuilt.empty()}, {"rebuilt", rebuilt},
+                                {"last_rebuilt", last_rebuilt}, {"last_rebuilt_frame", last_rebuilt_frame},
                                 {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
                                 {"paused", paused}, {"speed", speed}, {"knobs", values}, {"step_knobs", used}, {"pinned", pinned},
                                 {"held", held}, {"problem", problem}, {"clients", server.clients()}}

@@ -130,10 +130,18 @@ def lab06():
     try:
         s.send(cmd="speed", value=16)
         soft = s.frames(120)["max_strain"]
+        before = s.frames(1)["frame"]
+        s.send(cmd="set", knob="K", value=12)  # K alone: A does not depend on it, nothing is rebuilt
+        turned = s.until(lambda status, x: status["step_knobs"]["K"] == 12)
+        if turned["last_rebuilt_frame"] > before:
+            problems.append(f"lab 06: turning K rebuilt {turned['last_rebuilt']!r} at frame "
+                            f"{turned['last_rebuilt_frame']} (A does not depend on K)")
+        s.send(cmd="set", knob="K", value=10)
         s.send(cmd="set", knob="k", value=1e6)
         first = s.until(lambda status, x: status["step_knobs"]["k"] == 1e6)
-        if not first["refactored"]:
-            problems.append("lab 06: the first step after k = 1e6 does not say it refactored")
+        if first["last_rebuilt_frame"] <= turned["frame"] or "factored" not in first["last_rebuilt"]:
+            problems.append(f"lab 06: the step after k = 1e6 does not say A was factored again "
+                            f"(last rebuilt {first['last_rebuilt']!r} at frame {first['last_rebuilt_frame']})")
         stiff = s.frames(120)["max_strain"]
         s.send(cmd="set", knob="K", value=100)
         start = s.until(lambda status, x: status["step_knobs"]["K"] == 100)["frame"]
