@@ -117,49 +117,103 @@ def check_symptom(lab, symptom):
     return None
 
 
-def plant_all(lab, entries, every_case, log):
-    """(caught, lines) for one lab's entries, planted one at a time."""
+def references_of(lab):
+    """The lab's reference files, written as its student files in the tree."""
     references = {p.name: p.read_text() for p in (ROOT / "solutions" / lab).glob("*.cpp")}
     for name, text in references.items():
         write_if_changed(TREE / "labs" / lab / name, text)
+    return references
+
+
+def plant(lab, entry, references):
+    """Write the entry's mistake into the tree's student file; None, or why it cannot be planted."""
+    reference = references.get(entry["file"])
+    if reference is None:
+        return f"solutions/{lab}/{entry['file']}: no such reference file"
+    if reference.count(entry["find"]) != 1:
+        return f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
+    write_if_changed(TREE / "labs" / lab / entry["file"], reference.replace(entry["find"], entry["replace"]))
+    return None
+
+
+def targets_of(lab, entry):
+    return [f"{lab}_tests", *([lab] if entry.get("symptom") else [])]
+
+
+def judge(lab, entry, every_case, lines):
+    """None when the built tree catches the planted entry (and shows its symptom); else the problem."""
     program = TREE / "build" / "bin" / f"{lab}_tests"
+    passing = [name for name in entry["fails"] if not case_fails(program, name)]
+    if passing:
+        return "not caught: " + "; ".join(f'"{name}" passes' for name in passing)
+    if entry.get("symptom"):
+        shown = check_symptom(lab, entry["symptom"])
+        if shown:
+            return f"caught, but the handout's symptom does not show: {shown}"
+    if every_case:
+        others = [c for c in graded_cases(lab, program) if c not in entry["fails"] and case_fails(program, c)]
+        if others:
+            lines.append(f"  note {entry['id']}: also fails {'; '.join(others[:4])}")
+    return None
+
+
+def record(entry, problem, seconds, lines, log):
+    if problem:
+        lines.append(f"  FAIL {entry['id']} ({entry['what']}): {problem}")
+        return 0
+    log(f"  ok   {entry['id']}: {', '.join(entry['fails'])} fail ({seconds:.0f} s)")
+    return 1
+
+
+def restore(lab):
+    for source in (ROOT / "labs" / lab).glob("*.cpp"):
+        write_if_changed(TREE / "labs" / lab / source.name, source.read_text())
+
+
+def plant_all(lab, entries, every_case, log):
+    """(caught, lines) for one lab's entries, planted one at a time."""
+    references = references_of(lab)
     caught, lines = 0, []
     for entry in entries:
         start = time.monotonic()
-        reference = references.get(entry["file"])
-        problem = None
-        if reference is None:
-            problem = f"solutions/{lab}/{entry['file']}: no such reference file"
-        elif reference.count(entry["find"]) != 1:
-            problem = f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
-        else:
-            write_if_changed(TREE / "labs" / lab / entry["file"], reference.replace(entry["find"], entry["replace"]))
-            built, errors = build([f"{lab}_tests", *([lab] if entry.get("symptom") else [])])
-            if not built:
-                problem = "the planted file does not build: " + " | ".join(errors)
-            else:
-                passing = [name for name in entry["fails"] if not case_fails(program, name)]
-                if passing:
-                    problem = "not caught: " + "; ".join(f'"{name}" passes' for name in passing)
-                elif entry.get("symptom"):
-                    shown = check_symptom(lab, entry["symptom"])
-                    if shown:
-                        problem = f"caught, but the handout's symptom does not show: {shown}"
-                others = []
-                if not problem and every_case:
-                    others = [c for c in graded_cases(lab, program) if c not in entry["fails"] and case_fails(program, c)]
-                if others:
-                    lines.append(f"  note {entry['id']}: also fails {'; '.join(others[:4])}")
-            write_if_changed(TREE / "labs" / lab / entry["file"], reference)
-        seconds = time.monotonic() - start
-        if problem:
-            lines.append(f"  FAIL {entry['id']} ({entry['what']}): {problem}")
-        else:
-            caught += 1
-            log(f"  ok   {entry['id']}: {', '.join(entry['fails'])} fail ({seconds:.0f} s)")
-    for name in references:
-        write_if_changed(TREE / "labs" / lab / name, (ROOT / "labs" / lab / name).read_text())
+        problem = plant(lab, entry, references)
+        if problem is None:
+            built, errors = build(targets_of(lab, entry))
+            problem = judge(lab, entry, every_case, lines) if built else \
+                "the planted file does not build: " + " | ".join(errors)
+            write_if_changed(TREE / "labs" / lab / entry["file"], references[entry["file"]])
+        caught += record(entry, problem, time.monotonic() - start, lines, log)
+    restore(lab)
     return caught, lines
+
+
+def plant_first_entries(labs, log):
+    """{lab: (caught, 1, lines)}: the first entry of each lab planted at once and
+    built in one go. A lab's tests link the earlier labs' references, never
+    their student files, so the mistakes of different labs cannot meet."""
+    planted, results = {}, {}
+    for lab in labs:
+        entries = catalogue(lab)
+        if entries:
+            references = references_of(lab)
+            planted[lab] = (entries[0], plant(lab, entries[0], references), entries)
+    targets = [t for lab, (entry, problem, _) in planted.items() if problem is None for t in targets_of(lab, entry)]
+    start = time.monotonic()
+    built, errors = build(targets) if targets else (True, [])
+    if not built:  # which lab's plant breaks the build: each on its own
+        built_alone = {lab: build(targets_of(lab, entry))[0] for lab, (entry, problem, _) in planted.items()
+                       if problem is None}
+    for lab, (entry, problem, entries) in planted.items():
+        lines = []
+        if problem is None:
+            if built or built_alone.get(lab):
+                problem = judge(lab, entry, False, lines)
+            else:
+                problem = "the planted file does not build: " + " | ".join(errors)
+        caught = record(entry, problem, time.monotonic() - start, lines, log)
+        results[lab] = (caught, 1, lines + troubleshooting_gaps(lab, entries))
+        restore(lab)
+    return results
 
 
 def troubleshooting_gaps(lab, entries):
@@ -179,8 +233,11 @@ def troubleshooting_gaps(lab, entries):
 
 
 def run_mistakes(labs, limit=None, every_case=False, log=print):
-    """{lab: (caught, planted, lines)}; `limit` plants at most that many entries of a lab."""
+    """{lab: (caught, planted, lines)}; `limit` plants at most that many entries of a lab
+    (limit=1: the first entry of every lab at once, one build)."""
     sync_tree()
+    if limit == 1 and not every_case:
+        return plant_first_entries(labs, log)
     results = {}
     for lab in labs:
         entries = catalogue(lab)
