@@ -275,9 +275,7 @@ def check_views(checks, out, labs):
 def check_handout_commands(checks, labs):
     """Every command of every handout runs in its week's tree (--check)."""
     for result in check_handouts(labs):
-        where = f"week {result.week:02d}'s tree" if result.week else "their weeks' trees"
-        checks.record(not result.problems, f"handout {result.page}: {result.checked - len(result.problems)}/"
-                      f"{result.checked} commands run in {where}", result.problems)
+        checks.record(not result.problems, f"handout {result.summary()}", result.problems)
 
 
 def check_claims(checks, labs):

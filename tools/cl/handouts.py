@@ -3,8 +3,8 @@
 A handout (labs/labNN_name/README.md) is read by a student with the release of
 week NN and nothing else (docs/DESIGN.md §4). Each command it shows, in a code
 block or in `backticks`, is checked against that tree without building it: the
-week's tree is read from what release_files() ships (the stubs of every lab,
-the references of the labs before NN), and a lab's executable is asked with
+week's tree follows release_files()'s rule (the stubs of every lab, the
+references of the labs before NN), and a lab's executable is asked with
 --check (docs/DESIGN.md §3), which parses the flags and loads the scenes as the
 run would and writes nothing. The README's commands are checked in the week of
 the latest lab they name.
@@ -53,8 +53,11 @@ class PageResult:
     page: str
     week: int
     checked: int = 0
-    templates: int = 0
     problems: list = field(default_factory=list)
+
+    def summary(self):
+        where = f"week {self.week:02d}'s tree" if self.week else "their weeks' trees"
+        return f"{self.page}: {self.checked - len(self.problems)}/{self.checked} commands run in {where}"
 
 
 def page_commands(path):
@@ -116,7 +119,7 @@ class Week:
         return lab + ("_solution" if solution else ""), None
 
 
-def check_program(program, args, instructor_ok=False):
+def check_program(program, args):
     """Run PROGRAM ARGS --check from the course root; the problem, or None."""
     path = BIN / program
     if not path.is_file():
@@ -175,8 +178,8 @@ class PageChecker:
         program, why = self.week.program(name)
         return why or self.run_checked(program, args)
 
-    def run_checked(self, program, args, extra=()):
-        problem = check_program(program, [*args, *extra])
+    def run_checked(self, program, args):
+        problem = check_program(program, args)
         out = flag_value(args, "--out")
         if problem is None and out:
             self.outs.append((Path(out), flag_value(args, "--frames") is not None))
@@ -189,9 +192,8 @@ class PageChecker:
         return why or self.run_checked(program, rest[1:])
 
     def check_live(self, rest):
-        rest = [word for word in rest if word != "--bench"]  # ./course live's own
-        port = flag_value(rest, "--port")
-        if port is not None:
+        rest = [word for word in rest if word != "--bench" and not word.startswith("--port=")]  # live's own
+        if "--port" in rest:
             index = rest.index("--port")
             del rest[index:index + 2]
         if not rest:
@@ -261,11 +263,10 @@ _CASES = {}
 
 
 def matching_cases(lab, pattern):
+    """The lab's graded cases that `./course grade LAB -t PATTERN` would run."""
     if lab not in _CASES:
-        program = BIN / f"{lab}_tests_solution"
-        listed = subprocess.run([str(program), "--list-test-names-only"], capture_output=True, text=True,
-                                check=False).stdout if program.is_file() else ""
-        _CASES[lab] = [name.strip() for name in listed.splitlines() if name.strip()]
+        # The student's and the reference's programs hold the same cases (compiled once, linked twice).
+        _CASES[lab] = grade.list_names(BIN / f"{lab}_tests", grade.lab_tag(lab))
     selected = grade.case_filter(pattern)
     return [name for name in _CASES[lab] if selected(name)]
 
@@ -276,9 +277,8 @@ def check_page(path, week):
     for command in page_commands(path):
         if TEMPLATE.search(command.text):
             # A usage line is not run, but the programs it names must be in the week's tree.
-            result.templates += 1
             for token in re.findall(r"\blab\d\d(?:_[a-z0-9_]+)?\b", command.text):
-                why = Week(week or 15).program(token)[1] if week else None
+                why = Week(week).program(token)[1] if week else None
                 if why and not command.instructor:
                     result.problems.append(f"line {command.line}: {command.text}\n            {why}")
             continue
@@ -297,13 +297,13 @@ def check_page(path, week):
 def needed_targets(labs):
     targets = []
     for lab in labs:
-        targets += [lab, f"{lab}_tests_solution"]
+        targets += [lab, f"{lab}_tests"]
         if manifest().get(lab, {}).get("reference"):
             targets.append(f"{lab}_solution")
     return targets + ["trade", "extremes"]
 
 
-def check_handouts(labs, log=print):
+def check_handouts(labs):
     """One PageResult per lab's handout (and the README's, with every lab)."""
     results = [check_page(ROOT / "labs" / lab / "README.md", lab_number(lab)) for lab in labs]
     if set(labs) == set(lab_dirs()):
@@ -325,12 +325,8 @@ def cmd_handouts(argv):
         raise CourseError(str(failure), details=failure.lines) from None
     failed = 0
     for result in check_handouts(labs):
-        ok = not result.problems
-        print(f"handouts {result.page}: {result.checked - len(result.problems)}/{result.checked} commands run "
-              f"in week {result.week:02d}'s tree" if result.week else
-              f"handouts {result.page}: {result.checked - len(result.problems)}/{result.checked} commands run "
-              f"in their weeks' trees")
+        print(f"handouts {result.summary()}")
         for problem in result.problems:
             print(f"  FAIL {problem}")
-        failed += not ok
+        failed += bool(result.problems)
     return 1 if failed else 0
