@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 
@@ -14,14 +15,32 @@
 
 namespace cl {
 
+namespace {
+std::atomic<bool> blas_threads_chosen{false};
+}  // namespace
+
 bool set_blas_threads(int threads) {
   if (threads < 1) throw std::invalid_argument("set_blas_threads: threads " + std::to_string(threads) + " < 1");
+  blas_threads_chosen = true;
   void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
   if (symbol == nullptr) return false;
   using SetThreads = void (*)(int);
   reinterpret_cast<SetThreads>(symbol)(threads);
   return true;
 }
+
+namespace {
+// The first CHOLMOD factorization of a process whose program chose no BLAS
+// threads (and whose environment names none) makes the BLAS serial: see
+// set_blas_threads. A test program that factors a drape under a second job
+// (./course test builds the sanitizer alongside) otherwise took 30 s and more
+// for what one thread does in 4 s.
+void default_blas_threads() {
+  if (blas_threads_chosen.exchange(true)) return;
+  if (std::getenv("OPENBLAS_NUM_THREADS") != nullptr) return;
+  set_blas_threads(1);
+}
+}  // namespace
 
 MovableMap make_movable_map(const Eigen::VectorXd& inv_mass) {
   MovableMap map;
@@ -141,6 +160,7 @@ struct SpdFactorization::Cholmod {
   cholmod_common common;
   cholmod_factor* factor = nullptr;
   Cholmod() {
+    default_blas_threads();
     cholmod_start(&common);
     common.print = 0;  // library code never prints: failures are return values here
     common.supernodal = CHOLMOD_SUPERNODAL;

@@ -65,6 +65,8 @@ bool cholmod_available();
 // so any BLAS links); returns whether it could. OpenBLAS otherwise takes every
 // core, and its waiting threads spin: a benchmark that times serial methods
 // side by side sets 1, or a second job on the machine slows it many-fold.
+// A program that never calls it gets 1 at its first supernodal factorization,
+// unless OPENBLAS_NUM_THREADS is set (then OpenBLAS's own reading of it stands).
 bool set_blas_threads(int threads);
 
 // The flop count (Σ_j c_j², c_j the entries of L below the diagonal in column

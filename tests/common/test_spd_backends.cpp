@@ -4,6 +4,7 @@
 // chooses by the flop count it documents. Without CHOLMOD in the build the
 // supernodal requests fall back to Eigen, and the same checks hold.
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <random>
@@ -174,6 +175,28 @@ TEST_CASE("one BLAS thread gives the supernodal factorization's solves and a cou
   const cl::RowsX3 b = cl::RowsX3::Random(matrix.rows(), 3);
   const Eigen::MatrixXd expected = reference.solve3(b);
   CHECK_THAT(max_abs(Eigen::MatrixXd(supernodal.solve3(b)) - expected), WithinAbs(0.0, 1e-9 * max_abs(expected)));
+}
+
+TEST_CASE("a program that chose no BLAS threads factors with one", "[sparse][backend]") {
+  // OpenBLAS's own default is every core, and its idle threads spin: a test
+  // program's drape took 30 s and more under a second job instead of 4 s.
+  using GetThreads = int (*)();
+  const auto get_threads = reinterpret_cast<GetThreads>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  if (!cl::cholmod_available() || get_threads == nullptr || std::getenv("OPENBLAS_NUM_THREADS") != nullptr) {
+    SUCCEED("no OpenBLAS behind CHOLMOD, or OPENBLAS_NUM_THREADS chooses");
+    return;
+  }
+  std::mt19937_64 rng(11);
+  const cl::SparseMatrix matrix = grid_hessian(rng, 24);
+  cl::SpdFactorization supernodal(cl::SpdBackend::kSupernodal);
+  REQUIRE(supernodal.factor(matrix));
+  CHECK(get_threads() == 1);
+  // A program that chooses keeps its choice: the default applies once, first.
+  CHECK(cl::set_blas_threads(2));
+  cl::SpdFactorization again(cl::SpdBackend::kSupernodal);
+  REQUIRE(again.factor(matrix));
+  CHECK(get_threads() == 2);
+  cl::set_blas_threads(1);
 }
 
 namespace {
