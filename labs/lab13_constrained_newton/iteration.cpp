@@ -18,6 +18,12 @@ namespace cl::lab13 {
 
 namespace {
 
+// The part δ of the compressed springs' K_g that a refused matrix drops:
+// first 0.01, then ×4 (0.04, 0.16, 0.64) up to 1, all of it (lab 09's
+// kDrop, whose matrix is M plus a positive semidefinite one).
+constexpr double kFirstDropped = 1e-2;
+
+
 void check(const Settings& settings) {
   if (settings.iterations < 0) throw std::invalid_argument("iterations must be >= 0");
   if (!std::isfinite(settings.tolerance) || settings.tolerance < 0.0) {
@@ -95,13 +101,15 @@ StepReport Solver::step(Particles& particles, const Settings& settings, const It
 
 lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
                                        const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
-                                       lab09::Compression compression, Eigen::VectorXd& rhs) const {
+                                       lab09::Compression compression, double dropped, Eigen::VectorXd& rhs) const {
   // Lab 09's eliminated system (geometric_stiffness.h) at x, per spring e
   // with n = (x_i − x_j)/ℓ and s = 1/c_e: the mass on the diagonal, and the block
   //     Δt² [ s n nᵀ − (λ_e/ℓ)(I − n nᵀ) ]       (Δt² Jᵀ C⁻¹ J − Δt² K_g)
   // at (i,i), (j,j) and negated at (i,j), (j,i); the right-hand side
   // M(v̂ + Δt g) − Δt Jᵀ C⁻¹ φ. Coincident ends have no direction: an empty
-  // row of J and no K_g (lab 07's and lab 09's rule), so no block.
+  // row of J and no K_g (lab 07's and lab 09's rule), so no block. With kKeep
+  // a compressed spring's K_g block is scaled by 1 − dropped (iterate()'s
+  // correction); the right-hand side does not depend on it.
   const double dt2 = dt_ * dt_;
   const std::size_t m = springs_.size();
   Eigen::Matrix3Xd units(3, static_cast<Eigen::Index>(m));
@@ -129,7 +137,7 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
     const Eigen::Matrix3d along = n * n.transpose();
     Eigen::Matrix3d block = (dt2 * stiffness) * along;
     double force = lambda[index];
-    if (compression == lab09::Compression::kDrop) force = std::min(force, 0.0);
+    if (force > 0.0) force *= compression == lab09::Compression::kDrop ? 0.0 : 1.0 - dropped;
     if (force != 0.0) block -= (dt2 * force / length) * (Eigen::Matrix3d::Identity() - along);
     eliminated_.add_spring(e, block);
     const Eigen::Vector3d pull = (dt_ * stiffness * phi[index]) * n;
@@ -144,6 +152,7 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
     // With springs dropped from K_g it is M plus a positive semidefinite
     // matrix: only round-off refuses it, when Δt² k outweighs a mass by more
     // than a double resolves. Say so in terms of Δt.
+    const bool all_dropped = compression == lab09::Compression::kDrop || dropped == 1.0;
     double ratio = 0.0;
     for (std::size_t e = 0; e < m; ++e) {
       const Spring& s = springs_[e];
@@ -155,13 +164,13 @@ lab07::StepSolution Solver::schur_solve(const Eigen::Matrix3Xd& x, const Eigen::
       heaviest = std::max(heaviest, 1.0 / inv_mass_[p]);
     }
     char text[240];
-    if (compression == lab09::Compression::kDrop && ratio > 1e12) {
+    if (all_dropped && ratio > 1e12) {
       std::snprintf(text, sizeof text,
                     " to working precision: at dt = %.3g s, dt^2 k / m reaches %.2g, more than a double resolves; "
                     "use a smaller dt (--dt)",
                     dt_, ratio);
       solution.problem += text;
-    } else if (compression == lab09::Compression::kDrop && heaviest > 1e12 * lightest) {
+    } else if (all_dropped && heaviest > 1e12 * lightest) {
       std::snprintf(text, sizeof text,
                     " to working precision: the scene's masses span %.2g kg to %.2g kg, more than a double resolves "
                     "in one matrix; bring them within 1e12 of each other",
@@ -278,12 +287,18 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
   linear.method = method;
   const Timer clock;
   double excluded = 0.0;  // time spent only for the records
-  // Compressed springs: kept (the exact matrix) until the Cholesky refuses
-  // it, then dropped for 1, 2, 4, … iterations before the exact matrix is
-  // tried again, so that a buckling cloth pays a refused factorization on a
-  // few iterations of a step, not on every one, and still gets the exact
-  // matrix's quadratic convergence once the step's own matrix is definite.
-  int keep_again = 1, keep_wait = 1;  // the next iteration that tries kKeep; the wait after a refusal
+  // Compressed springs kept (kKeep): the exact matrix where the Cholesky
+  // factors it. Where it refuses, the iteration drops a part δ of the
+  // compressed springs' K_g (README.md, "Compression"): δ starts each step at
+  // 0; a refusal raises it to kFirstDropped, then 4δ, up to 1 (all dropped,
+  // always definite). An iteration that factored with δ > 0 lets the next one
+  // try δ/4 (0 below kFirstDropped), so that the exact matrix, and its
+  // quadratic convergence, comes back once the step's own matrix is definite;
+  // a lowered δ that is refused again waits 1, 2, 4, … iterations before the
+  // next lowering, so a buckled cloth pays a refused factorization on a few
+  // iterations of a step, not on every one.
+  double dropped = 0.0;
+  int lower_at = 1, lower_wait = 1;  // the next iteration that may lower δ; the wait after a refused lowering
 
   auto evaluate = [&](const Eigen::Matrix3Xd& at, const Eigen::VectorXd& multipliers) {
     return residuals(at, y, multipliers, springs_, inv_mass_, map_, compliance_, dt_);
@@ -337,17 +352,27 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     };
     lab07::StepSolution solution;
     Eigen::VectorXd rhs;  // the Schur right-hand side: −Δt ∇g(x)
-    lab09::Compression compression =
-        k >= keep_again ? settings.compression : lab09::Compression::kDrop;
-    if (schur) {
-      solution = schur_solve(x, velocity, lambda, settings.gravity, compression, rhs);
-      if (!solution.ok && compression == lab09::Compression::kKeep) {
-        ++report.refused_factorizations;
-        keep_again = k + keep_wait;
-        keep_wait *= 2;
-        compression = lab09::Compression::kDrop;
-        solution = schur_solve(x, velocity, lambda, settings.gravity, compression, rhs);
+    const lab09::Compression compression = settings.compression;
+    if (schur && compression == lab09::Compression::kKeep) {
+      bool lowered = false;
+      if (dropped > 0.0 && k >= lower_at) {
+        dropped = dropped < 4.0 * kFirstDropped ? 0.0 : 0.25 * dropped;
+        lowered = true;
       }
+      for (;;) {
+        solution = schur_solve(x, velocity, lambda, settings.gravity, compression, dropped, rhs);
+        if (solution.ok || dropped == 1.0) break;
+        ++report.refused_factorizations;
+        if (lowered) {
+          lower_at = k + lower_wait;
+          lower_wait *= 2;
+          lowered = false;
+        }
+        dropped = dropped == 0.0 ? kFirstDropped : std::min(1.0, 4.0 * dropped);
+      }
+      if (lowered) lower_wait = 1;
+    } else if (schur) {
+      solution = schur_solve(x, velocity, lambda, settings.gravity, compression, 0.0, rhs);
     } else {
       solution = lab09::solve_stiff(linearized(), lab09::geometric_stiffness(x, springs_, lambda, map_, settings.compression),
                                     method);
@@ -383,7 +408,7 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
       }
     };
     bool accepted = line_search(solution);
-    const bool exact = compression == lab09::Compression::kKeep;
+    const bool exact = compression == lab09::Compression::kKeep && dropped == 0.0;
     if (!accepted && !exact && schur && settings.exact_rescue) {
       // Only the exact Newton direction is sure to lower ψ (ψ'(0) = −2ψ): the
       // dropped one found no step length, so this iteration takes lab 07's
@@ -401,8 +426,9 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     report.backtracks += backtracks;
     if (!accepted && schur) {
       // The fallback past a fold (README.md, "Past a fold"): ψ found no step
-      // length, but the matrix just factored is positive definite, so Δx
-      // descends on g, lab 06's objective, whose minimiser is the step. A
+      // length, but the matrix just factored (with all or part of the
+      // compression dropped) is positive definite, so Δx descends on g, lab 06's
+      // objective, whose minimiser is the step. A
       // backtracking search on g along it, then λ re-warmed to the springs'
       // forces there (warm_start), and the next iteration is the constrained
       // one again, from a point where its matrix is g's exact Hessian.

@@ -37,13 +37,14 @@ struct Settings {
   Start start = Start::kPositions;
   Warm warm = Warm::kForces;
   // Compressed springs in K_g (README.md, "Compression"): kept (kKeep, the
-  // exact Jacobian: quadratic convergence near the step) where the matrix is
-  // definite; after a refusal (StepReport::refused_factorizations) dropped for
-  // 1, 2, 4, … iterations before the exact matrix is tried again; or always
-  // dropped (kDrop: always definite, but a slow linear tail).
+  // exact Jacobian: quadratic convergence near the step), a part of it
+  // dropped where the Cholesky refuses the matrix (0.01, 0.04, … up to all;
+  // StepReport::refused_factorizations) and taken back as the iterations go;
+  // or always dropped (kDrop: always definite, but a slow linear tail).
   lab09::Compression compression = lab09::Compression::kKeep;
   int max_backtracks = 12;   // halvings of α before the step gives up (α ≥ 2⁻¹²)
-  // A direction that is not the exact Newton one (dropped compression) and lowers ψ for no α: true, the iteration first tries lab
+  // A direction that is not the exact Newton one (compression partly or
+  // wholly dropped) and lowers ψ for no α: true, the iteration first tries lab
   // 07's KKT solve (an LU) of the exact system (StepReport::exact_rescues);
   // false (the default), it goes straight to the fallback on g (README.md,
   // "Past a fold"). On a 128² curtain the LU costs 15 s an iteration.
@@ -71,7 +72,7 @@ struct StepReport {
   int failed_decreases = 0;    // 1 when no α ≥ 2^-max_backtracks decreased ψ: the step stopped there
   int fallbacks = 0;           // iterations whose direction lowered ψ for no α and took a descent step on g
   int exact_rescues = 0;       // iterations that took lab 07's KKT solve instead (Settings::exact_rescue)
-  int refused_factorizations = 0;  // exact matrices the Cholesky refused (that iteration then drops compression)
+  int refused_factorizations = 0;  // matrices the Cholesky refused (that iteration then drops more of the compression)
   double force_error = 0.0, constraint_error = 0.0, merit = 0.0;  // at the result
   double seconds = 0.0;
   std::string linear_solver;   // "schur" (every c_e > 0: lab 09's primal solve) or "kkt" (some c_e = 0)
@@ -140,9 +141,11 @@ class Solver {
   // assembled per spring into eliminated_, then v_new and
   // λ = −C⁻¹(φ + Δt J v_new) as solve_stiff_schur gives them.
   // rhs: the right-hand side, −Δt ∇g(x).
+  // dropped: δ in [0, 1], the part of a compressed spring's K_g left out
+  // under kKeep (kDrop leaves all of it out).
   lab07::StepSolution schur_solve(const Eigen::Matrix3Xd& x, const Eigen::VectorXd& velocity,
                                   const Eigen::VectorXd& lambda, const Eigen::Vector3d& gravity,
-                                  lab09::Compression compression, Eigen::VectorXd& rhs) const;
+                                  lab09::Compression compression, double dropped, Eigen::VectorXd& rhs) const;
   // A KKT solve's problem that says "singular", in the scene's words: which
   // hard springs (a duplicate, coincident ends) or the count, and what to do.
   std::string hard_set_problem(const Eigen::Matrix3Xd& x, const std::string& problem) const;
