@@ -331,9 +331,9 @@ class VbdStepper : public Stepper {
 // it). Tolerance 0: K iterations, as the other iterative methods run; the
 // step ends earlier only at ψ = 0 or when no step length lowers the merit
 // (round-off), which the trade reads as "stopped before K", as Newton's.
-// Compressed springs in K_g: kept (the lab's default, the exact Jacobian,
-// with lab 07's KKT solve when the Schur matrix is not definite) for
-// constrained-newton, dropped for constrained-newton-drop.
+// Compressed springs in K_g: kept (the lab's default, the exact Jacobian;
+// where the Cholesky refuses it, a part of the compression dropped, 0.01 up
+// to all) for constrained-newton, dropped for constrained-newton-drop.
 class ConstrainedNewtonStepper : public Stepper {
  public:
   ConstrainedNewtonStepper(const Scene& scene, int iterations, lab09::Compression compression)
@@ -349,7 +349,8 @@ class ConstrainedNewtonStepper : public Stepper {
     const SpdBackendCounts before = spd_backend_counts();
     const lab13::StepReport report = solver_.step(particles, settings_);
     // Lab 09's primal (Schur) solve when every c_e > 0 (an iteration whose
-    // kept matrix is not definite drops compression: the same Cholesky), with
+    // kept matrix is not definite drops part of the compression: the same
+    // Cholesky, factored again), with
     // lab 07's KKT solve (LU) for an exact rescue; the KKT solve when some
     // spring is hard.
     std::string solver = report.linear_solver == "kkt" ? std::string("sparse-lu") : backends_since(before);
