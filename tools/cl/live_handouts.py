@@ -69,11 +69,16 @@ class Session:
                 self.process.wait()
 
 
-def drag_path(session, particle, goal, frames):
-    """The particle led to `goal` in a straight line, one target a frame, as a hand would."""
+def drag_path(session, particle, goal, frames, let_go=False):
+    """The particle led to `goal` in a straight line, one target a frame, as a hand would. With `let_go`, the
+    release follows the last target at once, as a hand that lets go while moving: a client slowed by a loaded
+    machine would otherwise hold the particle still at the goal for a few frames first, and nothing would go on."""
     start = session.position(particle)
     for k in range(1, frames + 1):
         session.send(cmd="drag", particle=particle, x=[a + (b - a) * k / frames for a, b in zip(start, goal)])
+        if k == frames and let_go:
+            session.send(cmd="release", particle=particle)
+            return
         session.frames(1)
 
 
@@ -102,8 +107,7 @@ def lab04():
         bottom = min(range(s.n), key=lambda p: s.position(p)[0] + s.position(p)[1])
         goal = [s.position(bottom)[0] + 0.3, s.position(bottom)[1], s.position(bottom)[2]]
         s.send(cmd="speed", value=1)
-        drag_path(s, bottom, goal, 15)
-        s.send(cmd="release", particle=bottom)
+        drag_path(s, bottom, goal, 15, let_go=True)
         released = s.until(lambda status, x: not status["held"])["frame"]
         at = s.position(bottom)[0]
         s.until(lambda status, x: status["frame"] >= released + 2)
