@@ -18,6 +18,9 @@ namespace cl {
 namespace {
 // The scenes this run loaded, for --check's line (in the order loaded, each once).
 std::vector<std::string> loaded_scenes;
+// Whether the mode this run is in reads --method (a mode that does not is
+// not said to run one in --check's line); refuse_unused_flags decides it.
+bool method_read_here = true;
 
 void note_scene(const Scene& scene) {
   std::ostringstream text;
@@ -279,6 +282,14 @@ void CommandLine::refuse_unused_flags() const {
   }
   const std::string current = active.empty() ? std::string("a run") : active.front();
   if (active.empty()) active.push_back("run");
+  method_read_here = true;
+  for (const MethodFlag& flag : mode_flags_) {
+    if (flag.option->get_name() != "--method") continue;
+    method_read_here = false;
+    for (const std::string& mode : active) {
+      if (std::find(flag.methods.begin(), flag.methods.end(), mode) != flag.methods.end()) method_read_here = true;
+    }
+  }
   for (const MethodFlag& flag : mode_flags_) {
     if (flag.option->count() == 0) continue;
     bool read = false;
@@ -316,7 +327,7 @@ Scene load_scene_for(const CommonOptions& options, const std::string& lab_scene_
 void start_run(const CommonOptions& options) {
   if (check_mode()) {
     std::string line;
-    if (!options.method.empty()) line += ", --method " + options.method;
+    if (!options.method.empty() && method_read_here) line += ", --method " + options.method;
     if (!options.out.empty()) line += ", writes " + options.out + "/";
     if (!options.summary.empty()) line += ", summary " + options.summary;
     throw CheckStop{line};
@@ -385,6 +396,7 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
   set_command_line(argc, words.data());
   bool check = false;
   loaded_scenes.clear();  // one run's scenes (a test calls run_main many times in one process)
+  method_read_here = true;
   if (app.get_option_no_throw("--check") == nullptr) {
     app.add_flag("--check", check,
                  "check the flags and the scene as a run would, print what would run, and stop (nothing written)");

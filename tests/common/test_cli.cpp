@@ -195,6 +195,33 @@ TEST_CASE("a flag the chosen mode does not read is refused in one line", "[commo
   CHECK(run_only.err == "probe: --steps: --convergence does not read it (only a run does)\n");
 }
 
+TEST_CASE("the check line names --method only in a mode that reads it", "[common][cli]") {
+  auto check_line = [](std::vector<std::string> arguments) {
+    cl::CommandLine line{"test", "probe"};
+    cl::CommonOptions options = cl::lab_defaults("two-particles");
+    options.method = "pd";
+    cl::add_common_options(line, options, cl::kFlagMethod);
+    bool convergence = false;
+    line.add_flag("--convergence", convergence, "a mode that runs every method");
+    line.modes({{"--convergence", {}}}, {"--method"});
+    arguments.insert(arguments.begin(), {"probe", "--check"});
+    std::vector<char*> argv;
+    for (std::string& argument : arguments) argv.push_back(argument.data());
+    std::ostringstream out;
+    std::streambuf* const saved_out = std::cout.rdbuf(out.rdbuf());
+    const int code = cl::run_main(line, static_cast<int>(argv.size()), argv.data(), [&] {
+      (void)cl::load_scene_for(options, kLab01Scenes);
+      cl::start_run(options);
+      return 0;
+    });
+    std::cout.rdbuf(saved_out);
+    CHECK(code == 0);
+    return out.str();
+  };
+  CHECK_THAT(check_line({}), Contains(", --method pd"));
+  CHECK_THAT(check_line({"--convergence"}), !Contains("--method"));
+}
+
 TEST_CASE("an unknown option is named and the program's options listed", "[common][cli]") {
   const Outcome unknown = run_modes({"--rho", "0.5"});
   CHECK(unknown.code == 2);
