@@ -446,6 +446,22 @@ StepReport Solver::iterate(Eigen::Matrix3Xd& x, Eigen::VectorXd& lambda, const E
     }
     if (!accepted) {
       report.failed_decreases = 1;  // x and λ stay at the last accepted iterate
+      // With hard springs there is no g to fall back on. A step that cannot
+      // leave its start, with errors far above round-off (above √tolerance),
+      // would end where it began, with v = 0: the cloth would hang frozen
+      // while every step said only "not converged". It is the step's failure.
+      const double floor = std::sqrt(settings.tolerance);
+      if (!schur && k == 1 && std::max(c.force_error, c.constraint_error) > floor) {
+        char text[640];
+        std::snprintf(text, sizeof text,
+                      "%sno step length along Newton's direction lowers the merit from the step's start (force error "
+                      "%.2g, constraint error %.2g): the hard constraints' KKT system is too ill-conditioned here for "
+                      "its direction (a sheet hung from one point folds until its rows are nearly dependent). Give the "
+                      "springs a finite stiffness (--stiffness): the compliant step falls back on lab 06's g",
+                      where.c_str(), c.force_error, c.constraint_error);
+        report.problem = text;
+        return report;
+      }
       break;
     }
     x = std::move(trial);

@@ -181,3 +181,27 @@ TEST_CASE("every step converges up to the live knob's top stiffness", "[lab13][p
   CHECK(at_most("steps done short of 60", 60 - run.steps_done, 0));
   CHECK(at_most("steps not converged", run.unconverged_steps, 0));
 }
+
+TEST_CASE("a hard step that cannot leave its start stops the run instead of freezing the cloth", "[lab13][pts=1]") {
+  // A hard sheet hung from one corner folds until Newton's direction for the
+  // hard step lowers the merit for no step length (README.md, "Where it
+  // holds"). A step that then ended where it began would set v = 0 and leave
+  // the sheet hanging still in mid-fall: the run must stop with the step's
+  // failure instead, and no step before it may end without moving.
+  cl::Scene scene = cl::load_scene(cl::lab_scene_dir("lab13_constrained_newton") + "/hard-corner-16.json");
+  cl::lab13::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+  cl::Particles state = scene.particles;
+  int frozen = 0;
+  const cl::lab13::RunResult run = cl::lab13::run_steps(
+      state, solver, settings_for(scene, 10, 1e-8), 60, nullptr, {},
+      [&](int, const cl::lab13::StepReport& report) {
+        if (report.iterations_done == 0 && !report.converged) ++frozen;
+      });
+  CAPTURE(run.steps_done, run.iterations_done, run.failed_decreases, run.unconverged_steps, run.problem);
+  CHECK(state.x.allFinite());
+  CHECK(at_most("steps that ended where they began", frozen, 0));
+  if (run.steps_done < 60) {
+    CHECK(run.step_failed);
+    CHECK_THAT(run.problem, Catch::Matchers::Contains("no step length"));
+  }
+}
