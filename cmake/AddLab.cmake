@@ -1,11 +1,22 @@
-# add_lab(NAME STUDENT a.cpp [b.cpp ...] [SUPPORT s.cpp ...] [DEPENDS earlier_lab ...]
-#         [LIBRARIES target ...])
+# add_lab(NAME STUDENT a.cpp [b.cpp ...] [SUPPORT s.cpp ...] [DRIVER d.cpp ...]
+#         [DEPENDS earlier_lab ...] [DRIVER_DEPENDS earlier_lab ...] [LIBRARIES target ...])
 #
 # Files by convention, all under labs/NAME unless said otherwise:
 #   STUDENT   the student's .cpp stubs; solutions/NAME holds a reference .cpp of
 #             the same name for each (in a student release: only for the labs
 #             before the current one, see docs/DESIGN.md §4)
-#   SUPPORT   lab code that is not the student's (used by the driver and tests)
+#   SUPPORT   lab code that is not the student's, which the graded tests or a
+#             later lab link (the solver code a test or a later lab calls)
+#   DRIVER    lab code that only this lab's executables link (its experiments
+#             and runs: experiments.cpp, run.cpp), compiled once with main.cpp.
+#             A grading build compiles only what the test program and the lab's
+#             own executable link, so an earlier lab's DRIVER files are never
+#             compiled for a later lab (a file a test or a later lab needs, put
+#             here, fails their link with an undefined reference)
+#   DEPENDS   the earlier labs this lab's code and graded tests use (and,
+#             transitively, theirs: a later lab inherits them)
+#   DRIVER_DEPENDS   earlier labs only the executable uses (lab 07's driver
+#             compares with lab 04's PBD): not inherited, not in the tests
 #   LIBRARIES extra link targets for the lab's code (e.g. OpenMP::OpenMP_CXX)
 #   main.cpp  the executable's driver
 #   scenes/   the lab's JSON scenes
@@ -18,8 +29,9 @@
 #   NAME_student                   the student's code (static library)
 #   NAME, NAME_tests               the executable and the graded tests, in build/bin.
 #                                  Both link this lab's student code and, for each
-#                                  earlier lab, its reference when it has one, else
-#                                  the student's code (isolation, docs/DESIGN.md §4);
+#                                  earlier lab they use (DEPENDS; the executable
+#                                  DRIVER_DEPENDS too), its reference when it has one,
+#                                  else the student's code (isolation, docs/DESIGN.md §4);
 #                                  NAME then says once on stderr which earlier labs
 #                                  run the student's code
 #   NAME_info                      the info program, linked like NAME_tests
@@ -43,7 +55,7 @@ set_property(GLOBAL PROPERTY CL_LAB_MANIFEST "")
 set(CL_SANITIZE_FLAGS -fsanitize=address,undefined -g -O1 -fno-omit-frame-pointer)
 
 function(add_lab name)
-  cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DEPENDS;LIBRARIES" ${ARGN})
+  cmake_parse_arguments(LAB "" "" "STUDENT;SUPPORT;DRIVER;DEPENDS;DRIVER_DEPENDS;LIBRARIES" ${ARGN})
   set(lab_dir "${PROJECT_SOURCE_DIR}/labs/${name}")
 
   set(solution_dir "${PROJECT_SOURCE_DIR}/solutions/${name}")
@@ -57,10 +69,22 @@ function(add_lab name)
   list(REMOVE_DUPLICATES closure)
   list(SORT closure ORDER DESCENDING)
   set_property(GLOBAL PROPERTY CL_LAB_CLOSURE_${name} ${closure})
+  # The executable's: those, and what only its driver uses (not inherited).
+  set(driver_closure ${closure})
+  foreach(dep IN LISTS LAB_DRIVER_DEPENDS)
+    get_property(dep_closure GLOBAL PROPERTY CL_LAB_CLOSURE_${dep})
+    list(APPEND driver_closure ${dep} ${dep_closure})
+  endforeach()
+  list(REMOVE_DUPLICATES driver_closure)
+  list(SORT driver_closure ORDER DESCENDING)
 
   set(closure_support ${name}_support)
   foreach(dep IN LISTS closure)
     list(APPEND closure_support ${dep}_support)
+  endforeach()
+  set(driver_support ${name}_support)
+  foreach(dep IN LISTS driver_closure)
+    list(APPEND driver_support ${dep}_support)
   endforeach()
 
   # A reference exists when all of the student files are in solutions/NAME; some
@@ -130,11 +154,11 @@ function(add_lab name)
     target_include_directories(${name}_support ${scope} "${PROJECT_SOURCE_DIR}/labs/${dep}")
   endforeach()
 
-  # Link lines: [support, implementation] for this lab, then for each earlier lab.
+  # Link lines: [support, implementation] for this lab, then for each earlier
+  # lab: the tests' (closure) and the executables' (driver_closure).
   set(reference_chain ${name}_support ${name}_reference)
   set(isolated_chain ${name}_support ${name}_student)
   set(links_json "")
-  set(student_earlier "")
   foreach(dep IN LISTS closure)
     get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
     list(APPEND reference_chain ${dep}_support ${dep}_reference)
@@ -144,12 +168,24 @@ function(add_lab name)
     else()
       list(APPEND isolated_chain ${dep}_support ${dep}_student)
       list(APPEND links_json "\"${dep}\": \"student\"")
+    endif()
+  endforeach()
+  set(driver_reference_chain ${name}_support ${name}_reference)
+  set(driver_isolated_chain ${name}_support ${name}_student)
+  set(student_earlier "")
+  foreach(dep IN LISTS driver_closure)
+    get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
+    list(APPEND driver_reference_chain ${dep}_support ${dep}_reference)
+    if(dep_has_reference)
+      list(APPEND driver_isolated_chain ${dep}_support ${dep}_reference)
+    else()
+      list(APPEND driver_isolated_chain ${dep}_support ${dep}_student)
       list(APPEND student_earlier ${dep})
     endif()
   endforeach()
   # A lab with a reference can only have earlier labs with references (a
   # release ships the past ones, the full tree all of them).
-  foreach(dep IN LISTS closure)
+  foreach(dep IN LISTS driver_closure)
     get_property(dep_has_reference GLOBAL PROPERTY CL_LAB_HAS_REFERENCE_${dep})
     if(has_reference AND NOT dep_has_reference)
       message(FATAL_ERROR "${name} has a reference in solutions/ but ${dep}, which it needs, has none")
@@ -159,18 +195,27 @@ function(add_lab name)
   set(bin_dir "${PROJECT_BINARY_DIR}/bin")
   set(scene_definition "CL_LAB_SCENE_DIR=cl::lab_scene_dir(\"${name}\")")
 
-  # main.cpp is compiled once, for NAME and NAME_solution alike: what differs
-  # (the program's name, the earlier labs it runs as the student's code) is a
-  # two-line source generated per executable (cl_program_name, common/cli.h).
-  add_library(${name}_driver OBJECT "${lab_dir}/main.cpp")
-  target_link_libraries(${name}_driver PRIVATE ${closure_support})
+  # main.cpp and the DRIVER files are compiled once, for NAME and NAME_solution
+  # alike: what differs (the program's name, the earlier labs it runs as the
+  # student's code) is a two-line source generated per executable
+  # (cl_program_name, common/cli.h). Only the executables link them, so
+  # building a later lab's tests or executable never compiles them.
+  set(driver_sources "${lab_dir}/main.cpp")
+  foreach(file IN LISTS LAB_DRIVER)
+    list(APPEND driver_sources "${lab_dir}/${file}")
+  endforeach()
+  add_library(${name}_driver OBJECT ${driver_sources})
+  target_link_libraries(${name}_driver PRIVATE ${driver_support})
+  foreach(dep IN LISTS driver_closure)
+    target_include_directories(${name}_driver PRIVATE "${PROJECT_SOURCE_DIR}/labs/${dep}")
+  endforeach()
   target_compile_definitions(${name}_driver PRIVATE ${scene_definition} CL_LAB_NAME="${name}"
                              CL_PROGRAM_NAME=cl_program_name CL_STUDENT_EARLIER_LABS=cl_student_earlier_labs)
   list(SORT student_earlier)
   list(JOIN student_earlier " " student_earlier)
   _cl_identity_source(${name} "${student_earlier}" identity)
   add_executable(${name} "${identity}")
-  target_link_libraries(${name} PRIVATE ${name}_driver ${isolated_chain} common)
+  target_link_libraries(${name} PRIVATE ${name}_driver ${driver_isolated_chain} common)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
   # The graded tests are compiled once and linked twice: against the student's
@@ -218,7 +263,7 @@ function(add_lab name)
   if(has_reference)
     _cl_identity_source(${name}_solution "" identity)
     add_executable(${name}_solution "${identity}")
-    target_link_libraries(${name}_solution PRIVATE ${name}_driver ${reference_chain} common)
+    target_link_libraries(${name}_solution PRIVATE ${name}_driver ${driver_reference_chain} common)
     set_target_properties(${name}_solution PROPERTIES RUNTIME_OUTPUT_DIRECTORY "${bin_dir}")
 
     add_executable(${name}_tests_solution $<TARGET_OBJECTS:${name}_test_objects>)

@@ -18,13 +18,10 @@
 #include "common/live_server.h"
 #include "common/metrics.h"
 #include "common/output.h"
+#include "common/source_dir.h"
 #include "common/summary.h"
 #include "common/timer.h"
 #include "common/trajectory.h"
-
-#ifndef CL_SOURCE_DIR
-#define CL_SOURCE_DIR "."
-#endif
 
 namespace cl {
 
@@ -64,12 +61,12 @@ using Clock = std::chrono::steady_clock;
 std::string live_page() {
   const std::string three = "/usr/share/javascript/three/";
   const char* hint = "install Debian's libjs-three: ./course installs it";
-  std::string page = read_text(std::string(CL_SOURCE_DIR) + "/tools/cl/live_page.html", "the course's tree");
+  std::string page = read_text(std::string(source_dir()) + "/tools/cl/live_page.html", "the course's tree");
   replace_once(page, "<!--three-->",
                "<script>\n" + read_text(three + "three.min.js", hint) + "\n</script>\n<script>\n" +
                    read_text(three + "examples/js/controls/OrbitControls.js", hint) + "\n</script>");
   replace_once(page, "<!--player-->",
-               "<script>\n" + read_text(std::string(CL_SOURCE_DIR) + "/tools/cl/view_player.js", "the course's tree") +
+               "<script>\n" + read_text(std::string(source_dir()) + "/tools/cl/view_player.js", "the course's tree") +
                    "\n</script>");
   return page;
 }

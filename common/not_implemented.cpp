@@ -1,11 +1,13 @@
 #include "common/not_implemented.h"
 
+#include "common/source_dir.h"
+
 namespace cl {
 
 namespace {
 // Print paths relative to the course so messages read the same on every machine.
 std::string course_relative(const std::string& path) {
-  const std::string root = std::string(CL_SOURCE_DIR) + "/";
+  const std::string root = std::string(source_dir()) + "/";
   if (path.compare(0, root.size(), root) == 0) return path.substr(root.size());
   return path;
 }

@@ -15,6 +15,8 @@
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
 
+#include "common/source_dir.h"
+
 namespace cl {
 
 namespace {
@@ -623,7 +625,7 @@ std::string resolve_scene_path(const std::string& name_or_path, const std::strin
   if (looks_like_path || fs::is_regular_file(name_or_path, error)) return name_or_path;
 
   std::vector<fs::path> places{fs::path(lab_scene_dir)};
-  const fs::path labs = fs::path(CL_SOURCE_DIR) / "labs";
+  const fs::path labs = fs::path(source_dir()) / "labs";
   if (fs::is_directory(labs, error)) {
     std::vector<fs::path> lab_dirs;
     for (const auto& entry : fs::directory_iterator(labs, error)) lab_dirs.push_back(entry.path() / "scenes");
@@ -685,7 +687,7 @@ const char* shape_name(ColliderShape shape) {
 }
 
 std::string lab_scene_dir(const std::string& lab) {
-  return (fs::path(CL_SOURCE_DIR) / "labs" / lab / "scenes").string();
+  return (fs::path(source_dir()) / "labs" / lab / "scenes").string();
 }
 
 std::vector<std::string> list_scene_names(const std::string& scene_dir) {

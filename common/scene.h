@@ -111,7 +111,8 @@ std::vector<std::string> list_scene_names(const std::string& scene_dir);
 // labs/LAB/scenes in this course tree, as an absolute path. Drivers and tests
 // see it as CL_LAB_SCENE_DIR (cmake/AddLab.cmake); a function rather than a
 // path on every compile line, so that the tree's path is compiled into one
-// file (scene.cpp) and a lab's compile lines do not depend on where it lies.
+// file (common/source_dir.cpp) and a lab's compile lines do not depend on
+// where it lies.
 std::string lab_scene_dir(const std::string& lab);
 
 // One line for a driver's header: "name (N particles, M springs)", with
