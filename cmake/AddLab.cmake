@@ -61,22 +61,10 @@ function(add_lab name)
   set(solution_dir "${PROJECT_SOURCE_DIR}/solutions/${name}")
 
   # Earlier labs this one needs, transitively, newest first (static link order).
-  set(closure "")
-  foreach(dep IN LISTS LAB_DEPENDS)
-    get_property(dep_closure GLOBAL PROPERTY CL_LAB_CLOSURE_${dep})
-    list(APPEND closure ${dep} ${dep_closure})
-  endforeach()
-  list(REMOVE_DUPLICATES closure)
-  list(SORT closure ORDER DESCENDING)
+  _cl_closure(closure ${LAB_DEPENDS})
   set_property(GLOBAL PROPERTY CL_LAB_CLOSURE_${name} ${closure})
   # The executable's: those, and what only its driver uses (not inherited).
-  set(driver_closure ${closure})
-  foreach(dep IN LISTS LAB_DRIVER_DEPENDS)
-    get_property(dep_closure GLOBAL PROPERTY CL_LAB_CLOSURE_${dep})
-    list(APPEND driver_closure ${dep} ${dep_closure})
-  endforeach()
-  list(REMOVE_DUPLICATES driver_closure)
-  list(SORT driver_closure ORDER DESCENDING)
+  _cl_closure(driver_closure ${LAB_DEPENDS} ${LAB_DRIVER_DEPENDS})
 
   set(closure_support ${name}_support)
   foreach(dep IN LISTS closure)
@@ -302,6 +290,19 @@ endfunction()
 
 # Writes the two-line source that names executable `program` (cl_program_name,
 # cl_student_earlier_labs in common/cli.h); sets `out` to its path.
+# The labs given after `out` and, transitively, the labs they need, newest
+# first (static link order), each once.
+function(_cl_closure out)
+  set(result "")
+  foreach(dep IN LISTS ARGN)
+    get_property(dep_closure GLOBAL PROPERTY CL_LAB_CLOSURE_${dep})
+    list(APPEND result ${dep} ${dep_closure})
+  endforeach()
+  list(REMOVE_DUPLICATES result)
+  list(SORT result ORDER DESCENDING)
+  set(${out} ${result} PARENT_SCOPE)
+endfunction()
+
 # The link lines of a lab's programs over `deps` (earlier labs, latest first):
 # [support, implementation] for the lab, then for each dep. The reference
 # chain links every reference; the isolated one the lab's student code and each
