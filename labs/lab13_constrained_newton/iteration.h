@@ -76,7 +76,10 @@ struct StepReport {
   double force_error = 0.0, constraint_error = 0.0, merit = 0.0;  // at the result
   double seconds = 0.0;
   std::string linear_solver;   // "schur" (every c_e > 0: lab 09's primal solve) or "kkt" (some c_e = 0)
-  std::string problem;         // non-empty: a solve failed; the particles are unchanged
+  // Non-empty: a solve failed, or (hard springs) no step length lowers ψ at
+  // the first iteration while an error is above √tolerance (README.md, "Where
+  // it holds"); the particles are unchanged.
+  std::string problem;
 };
 
 // The springs' mean rest length (m): convergence()'s length scale. 1 m when
