@@ -52,10 +52,25 @@ Residuals residuals(const Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, const 
     const int p = map.particle_of[static_cast<std::size_t>(k)];
     r.inertia.segment<3>(3 * k) = (x.col(p) - y.col(p)) / (inv_mass[p] * dt * dt);
   }
-  const SparseMatrix jacobian = lab07::constraint_jacobian(x, springs, map);
-  r.constraint_force = jacobian.transpose() * lambda;
-  r.force = r.inertia - r.constraint_force;
+  // φ (lab07::constraint_values checks the springs), then Jᵀλ spring by
+  // spring: row e of lab07::constraint_jacobian is +n_e on i's unknown and
+  // −n_e on j's (none for coincident ends), so λ_e n_e adds to i and
+  // subtracts from j. No J is assembled: the line search calls this once per
+  // trial step.
   r.constraint = lab07::constraint_values(x, springs);
+  r.constraint_force = Eigen::VectorXd::Zero(3 * u);
+  for (std::size_t e = 0; e < springs.size(); ++e) {
+    const Spring& s = springs[e];
+    const Eigen::Vector3d d = x.col(s.i) - x.col(s.j);
+    const double length = d.norm();
+    if (!(length > 0.0)) continue;
+    const Eigen::Vector3d pull = lambda[static_cast<Eigen::Index>(e)] * (d / length);
+    const int ui = map.unknown_of[static_cast<std::size_t>(s.i)];
+    const int uj = map.unknown_of[static_cast<std::size_t>(s.j)];
+    if (ui >= 0) r.constraint_force.segment<3>(3 * ui) += pull;
+    if (uj >= 0) r.constraint_force.segment<3>(3 * uj) -= pull;
+  }
+  r.force = r.inertia - r.constraint_force;
   if (compliance.size() != 0) r.constraint += compliance.cwiseProduct(lambda);
   return r;
 }
