@@ -73,7 +73,9 @@ bool set_blas_threads(int threads);
 // j, in CHOLMOD's ordering) from which kAutomatic takes the supernodal
 // factorization. Measured with bench/bench_lab06 (BM_FactorBackends, CPU
 // time, OpenBLAS): PD's A at 64² (4·10⁶) factors faster with Eigen, Newton's
-// Hessian at 32² (1.2·10⁷) twice as fast with CHOLMOD, 6× at 128² (10⁹).
+// Hessian at 32² (1.2·10⁷) twice as fast with CHOLMOD, 6× at 128² (10⁹),
+// both before CHOLMOD got the coarser supernodes it has now (common/sparse.cpp),
+// which made it faster still.
 inline constexpr double kSupernodalFlops = 1e7;
 
 // How many numeric factorizations each backend has done in this process, over
