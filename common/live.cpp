@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -126,7 +127,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
 
   auto send_error = [&](int client, const std::string& line) {
     live_log(line);  // a page that floods the run with bad messages gets its answers; stderr a summary
-    server.send_text(client, nlohmann::json{{"type", "error"}, {"text", line}}.dump());
+    server.send_text(client, live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}));
   };
   auto release = [&](std::map<int, Hold>::iterator hold) {
     const int p = hold->first;
@@ -148,14 +149,13 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     for (const Triangle& triangle : scene.triangles) {
       triangles.push_back(triangle.i), triangles.push_back(triangle.j), triangles.push_back(triangle.k);
     }
-    server.send_text(client, nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
+    server.send_text(client, live_json_text(nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
                                             {"method", run.method}, {"particles", n}, {"springs", springs},
                                             {"triangles", triangles}, {"rest_lengths", rest}, {"knobs", nlohmann::json::parse(knobs.json())},
                                             {"energy_name", run.energy_name}, {"command", command_line()},
-                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}
-                                 .dump());
+                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}));
     if (!problem.empty()) {  // a page opened after the run stopped sees why (its frame follows: the last good one)
-      server.send_text(client, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
+      server.send_text(client, live_json_text(nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}));
     }
   };
 
@@ -287,7 +287,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       paused = problem_paused = true;
       problem_line = "live: frame " + std::to_string(frame) + ": " + problem + " (paused; reset to go on)";
       live_log(problem_line);
-      server.send_text(-1, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
+      server.send_text(-1, live_json_text(nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}));
     }
     ++version;
   };
@@ -317,13 +317,12 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
           held.push_back({{"particle", p}, {"x", {state.x(0, p), state.x(1, p), state.x(2, p)}}});
         }
         const double shown_energy = std::isfinite(energy_now) ? energy_now : 0.0;
-        status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
+        status = live_json_text(nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
                                 {"previous_step_seconds", previous_step_seconds}, {"refactored", !rebuilt.empty()}, {"rebuilt", rebuilt},
                                 {"last_rebuilt", last_rebuilt}, {"last_rebuilt_frame", last_rebuilt_frame},
                                 {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
                                 {"paused", paused}, {"speed", speed}, {"knobs", values}, {"step_knobs", used}, {"pinned", pinned},
-                                {"held", held}, {"problem", problem}, {"clients", server.clients()}}
-                     .dump();
+                                {"held", held}, {"problem", problem}, {"clients", server.clients()}});
       }
       server.send_frame(client, status, data);
       sent[client] = version;
@@ -331,7 +330,13 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   };
 
   while (!stop && !live_stop_requested) {
-    for (const LiveInbound& inbound : server.take_inbound()) apply(inbound);
+    for (const LiveInbound& inbound : server.take_inbound()) {
+      try {
+        apply(inbound);
+      } catch (const std::exception& error) {  // one message's failure is its page's error, never the run's end
+        send_error(inbound.client, std::string("live: a message could not be handled: ") + error.what());
+      }
+    }
     if (stop) break;
     const Clock::time_point now = Clock::now();
     if (step_once || (!paused && problem.empty() && now >= next_due)) {

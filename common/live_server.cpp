@@ -92,7 +92,7 @@ std::string http_answer(int code, const char* reason, const std::string& body) {
          "Content-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\nCache-Control: no-store\r\n\r\n" + body;
 }
 
-std::string error_message(const std::string& line) { return nlohmann::json{{"type", "error"}, {"text", line}}.dump(); }
+std::string error_message(const std::string& line) { return live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}); }
 
 struct LogState {
   std::mutex mutex;
