@@ -421,7 +421,6 @@ void LiveServer::Loop::run() {
       if (read(shared->wake_fd, &count, sizeof count) < 0) { /* nothing to read: a spurious wake */ }
     }
     const Clock::time_point now = Clock::now();
-    if (polled[1].revents & POLLIN) accept_new(now);
     for (std::size_t i = 0; i < polled_connections.size(); ++i) {
       const auto connection = polled_connections[i];
       const short revents = polled[i + 2].revents;
@@ -438,6 +437,9 @@ void LiveServer::Loop::run() {
       fill(*connection);
       if (!write_some(*connection, now)) close_connection(connection, "");
     }
+    // After the round, never before it: a new comer may close the oldest pending connection, which the
+    // round would have touched after its closing (a use after free).
+    if (polled[1].revents & POLLIN) accept_new(now);
     // Deadlines, and what the loop's side asked (an eviction, a client whose outbox overflowed).
     for (auto connection = connections.begin(); connection != connections.end();) {
       const auto next = std::next(connection);
