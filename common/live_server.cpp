@@ -258,6 +258,11 @@ struct LiveServer::Loop {
     bool refusing = false;        // the message in progress is refused: its frames are discarded
     std::uint64_t skip = 0;       // payload bytes of a refused frame still to discard
     bool spoke = false;           // kSocket: it has sent something since its handshake
+    std::string pong;             // the payload of the newest ping not answered yet (one pong answers them all)
+    bool pong_due = false;
+    std::size_t out_frame = 0;    // the bytes of `out` that are a frame (bounded: the newest wins), not counted
+    Clock::time_point controls_since;  // the second in which `controls` control frames were read
+    int controls = 0;
   };
 
   LiveServer* server = nullptr;
@@ -445,12 +450,13 @@ void LiveServer::Loop::run() {
       const auto next = std::next(connection);
       const bool waiting = connection->out_at < connection->out.size();
       bool evict = false;
-      std::size_t text_bytes = 0;
+      // Every byte queued toward it but its frames (the newest replaces the one waiting: they cannot pile up).
+      std::size_t queued = connection->out.size() - connection->out_at - std::min(connection->out_frame, connection->out.size() - connection->out_at);
       if (connection->state == State::kSocket) {
         const std::lock_guard<std::mutex> lock(shared->mutex);
         const Shared::Client& client = shared->clients[connection->client];
         evict = client.evict;
-        text_bytes = client.text_bytes;
+        queued += client.text_bytes + (connection->pong_due ? connection->pong.size() + 2 : 0);
       }
       const std::string id = "page " + std::to_string(connection->client);
       if (connection->state == State::kRequest && since(connection->opened, now) > kRequestSeconds) {
@@ -460,9 +466,9 @@ void LiveServer::Loop::run() {
       } else if (connection->state == State::kSocket) {
         if (evict) {
           close_connection(connection, "live: " + id + " closed: a new page came and it was heard from least recently");
-        } else if (text_bytes > kOutboxBytes) {
+        } else if (queued > kOutboxBytes) {
           close_connection(connection, "live: " + id + " dropped: over " + std::to_string(kOutboxBytes >> 20) +
-                                           " MB of messages waiting for it (it reads nothing)");
+                                           " MB waiting for it (it reads too little of what it asks for)");
         } else if (waiting && since(connection->progress, now) > kStalledSeconds) {
           close_connection(connection, "live: " + id + " dropped: it took nothing off its socket for " +
                                            std::to_string(int(kStalledSeconds)) + " s");
@@ -473,6 +479,7 @@ void LiveServer::Loop::run() {
           connection->pinged = now;
           connection->out = websocket_frame(kOpPing, "", 0);
           connection->out_at = 0;
+          connection->out_frame = 0;
         }
       }
       connection = next;
@@ -654,6 +661,10 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
     }
     connection.heard = now;
     const bool control = (header.opcode & 0x8) != 0;
+    if (control) {  // at most kControlsPerSecond, as its text is held to its queue: the rest wait in TCP
+      if (since(connection.controls_since, now) >= 1.0) connection.controls_since = now, connection.controls = 0;
+      if (connection.controls >= kControlsPerSecond) break;
+    }
     const std::size_t had = connection.refusing ? 0 : connection.message.size();
     if (!control && (header.opcode == kOpBinary || connection.refusing || had + header.length > kLiveMessageCap)) {
       // Refused by its header: the payload is discarded as it arrives, never held.
@@ -684,8 +695,10 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
       connection.state = State::kClosing;
       break;
     }
-    if (header.opcode == kOpPing) {
-      connection.out.append(websocket_frame(kOpPong, payload.data(), payload.size()));
+    if (control) ++connection.controls;
+    if (header.opcode == kOpPing) {  // answered when its socket has taken what it was given (fill)
+      connection.pong = std::move(payload);
+      connection.pong_due = true;
       continue;
     }
     if (header.opcode == kOpPong) continue;
@@ -705,14 +718,17 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
 // The client's outbox into its socket's buffer, when that is empty: texts first, then the newest frame.
 void LiveServer::Loop::fill(Connection& connection) {
   if (connection.state != State::kSocket) return;
-  if (connection.out_at == connection.out.size()) connection.out.clear(), connection.out_at = 0;
+  if (connection.out_at == connection.out.size()) connection.out.clear(), connection.out_at = 0, connection.out_frame = 0;
   if (!connection.out.empty()) return;
+  if (connection.pong_due) connection.out = websocket_frame(kOpPong, connection.pong.data(), connection.pong.size());
+  connection.pong_due = false;
   const std::lock_guard<std::mutex> lock(shared->mutex);
   Shared::Client& client = shared->clients[connection.client];
   for (std::string& text : client.texts) connection.out += text;
   client.texts.clear();
   client.text_bytes = 0;
   connection.out += client.frame;
+  connection.out_frame = client.frame.size();
   client.frame.clear();
 }
 

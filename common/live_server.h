@@ -79,6 +79,7 @@ class LiveServer {
   static constexpr double kStalledSeconds = 5.0;
   static constexpr double kPingSeconds = 2.0;
   static constexpr double kSilentSeconds = 20.0;  // a WebSocket that answers nothing, not even a ping
+  static constexpr int kControlsPerSecond = 32;    // control frames (ping, pong) read from one client a second
 
   struct Shared;  // the queues both threads touch (live_server.cpp)
   struct Loop;    // the server thread's own state
