@@ -87,6 +87,13 @@ std::string lower(std::string text) {
   return text;
 }
 
+// A header's value as a stderr line may show it: at most 80 bytes, printable ASCII ('?' for the rest).
+std::string shown(const std::string& text) {
+  std::string out = text.substr(0, 80);
+  for (char& c : out) c = static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f ? '?' : c;
+  return out;
+}
+
 std::string http_answer(int code, const char* reason, const std::string& body) {
   return "HTTP/1.1 " + std::to_string(code) + " " + reason + "\r\nContent-Type: text/plain; charset=utf-8\r\n" +
          "Content-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\nCache-Control: no-store\r\n\r\n" + body;
@@ -201,16 +208,20 @@ std::string live_token() {
   return token;
 }
 
-bool live_origin_allowed(const char* origin, int port) {
-  if (origin == nullptr) return true;
-  const std::string given(origin);
+bool live_origin_allowed(const std::optional<std::string>& origin, int port) {
+  if (!origin) return true;
   const std::string tail = ":" + std::to_string(port);
-  return given == "http://127.0.0.1" + tail || given == "http://localhost" + tail;
+  return *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail;
 }
 
-bool live_token_matches(const char* query, const std::string& token) {
-  if (query == nullptr || token.empty()) return false;
-  const std::string text(query);
+bool live_host_allowed(const std::string& host, int port) {
+  const std::string tail = ":" + std::to_string(port);
+  return host == "127.0.0.1" + tail || host == "localhost" + tail || (port == 80 && (host == "127.0.0.1" || host == "localhost"));
+}
+
+bool live_token_matches(const std::optional<std::string>& query, const std::string& token) {
+  if (!query || token.empty()) return false;
+  const std::string& text = *query;
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t end = std::min(text.find('&', start), text.size());
@@ -542,13 +553,15 @@ void LiveServer::Loop::refuse(Connection& connection, int code, const char* reas
 
 void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point now) {
   const std::size_t end = connection.in.find("\r\n\r\n");
-  if (end == std::string::npos) {
-    if (connection.in.size() > kRequestCap) refuse(connection, 431, "Request Header Fields Too Large", "live: a request head over 8 KiB", "");
-    return;
+  // Over the cap however it came: still coming, or whole in one write (a 60 kB head used to be served).
+  if (end == std::string::npos ? connection.in.size() > kRequestCap : end + 4 > kRequestCap) {
+    return refuse(connection, 431, "Request Header Fields Too Large", "live: a request head over 8 KiB", "");
   }
+  if (end == std::string::npos) return;
   const std::string head = connection.in.substr(0, end);
   connection.in.erase(0, end + 4);
   std::map<std::string, std::string> headers;
+  std::string repeated;  // a header this server reads, given twice (which one counts is anybody's guess)
   std::size_t line_end = head.find("\r\n");
   const std::string request_line = head.substr(0, line_end);
   while (line_end != std::string::npos) {
@@ -560,7 +573,9 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
     std::string value = line.substr(colon + 1);
     value.erase(0, std::min(value.find_first_not_of(" \t"), value.size()));
     value.erase(value.find_last_not_of(" \t") + 1);
-    headers[lower(line.substr(0, colon))] = value;
+    const std::string name = lower(line.substr(0, colon));
+    const bool read = name == "host" || name == "origin" || name == "upgrade" || name.rfind("sec-websocket-", 0) == 0;
+    if (!headers.emplace(name, value).second && read) repeated = name;
   }
   const std::size_t space = request_line.find(' ');
   const std::size_t space2 = request_line.find(' ', space == std::string::npos ? 0 : space + 1);
@@ -570,9 +585,19 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
   const std::string path = target.substr(0, question);
   const std::string query = question == std::string::npos ? std::string() : target.substr(question + 1);
   if (method != "GET") return refuse(connection, 405, "Method Not Allowed", "live: only GET", "");
+  if (!repeated.empty()) {
+    return refuse(connection, 400, "Bad Request", "live: a header given twice (" + shown(repeated) + ")",
+                  "live: a request with two " + shown(repeated) + " headers, refused (400)");
+  }
+  const auto host = headers.find("host");
+  if (host == headers.end()) return refuse(connection, 400, "Bad Request", "live: a request without Host", "");
+  if (!live_host_allowed(host->second, server->port())) {
+    return refuse(connection, 403, "Forbidden", "live: a request for another host",
+                  "live: a request for the host '" + shown(host->second) + "', refused (403)");
+  }
   if (path != "/" && path != "/ws") return refuse(connection, 404, "Not Found", "live: not found (the page is /?token=...)", "");
   const bool upgrade = lower(headers["upgrade"]) == "websocket";
-  if (!live_token_matches(query.c_str(), server->token())) {
+  if (!live_token_matches(question == std::string::npos ? std::nullopt : std::optional<std::string>(query), server->token())) {
     return refuse(connection, 403, "Forbidden", "live: wrong or missing token (open the URL the program printed)",
                   path == "/" && !upgrade ? "live: a request for the page without the run's token, refused (403)"
                                           : "live: a WebSocket without the run's token, refused (403)");
@@ -586,11 +611,9 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
     return;
   }
   const auto origin = headers.find("origin");
-  if (!live_origin_allowed(origin == headers.end() ? nullptr : origin->second.c_str(), server->port())) {
-    std::string shown = origin->second.substr(0, 80);
-    for (char& c : shown) c = static_cast<unsigned char>(c) < 0x20 ? '?' : c;
+  if (!live_origin_allowed(origin == headers.end() ? std::nullopt : std::optional<std::string>(origin->second), server->port())) {
     return refuse(connection, 403, "Forbidden", "live: a WebSocket from a foreign Origin",
-                  "live: a WebSocket from the foreign Origin '" + shown + "', refused (403)");
+                  "live: a WebSocket from the foreign Origin '" + shown(origin->second) + "', refused (403)");
   }
   if (!upgrade || headers["sec-websocket-key"].empty() || headers["sec-websocket-version"] != "13") {
     return refuse(connection, 400, "Bad Request", "live: /ws is a WebSocket (version 13)", "");

@@ -23,6 +23,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -94,13 +95,19 @@ class LiveServer {
 // 128 random bits as 32 hex digits (std::random_device).
 std::string live_token();
 
-// Whether `origin` (the WebSocket's Origin header; null: none given) may
-// connect to a server on `port`: none (a client that is not a browser), or
-// http://127.0.0.1:PORT or http://localhost:PORT exactly.
-bool live_origin_allowed(const char* origin, int port);
+// Whether `origin` (the WebSocket's Origin header, every byte of it; none:
+// not given) may connect to a server on `port`: none (a client that is not a
+// browser), or http://127.0.0.1:PORT or http://localhost:PORT exactly.
+bool live_origin_allowed(const std::optional<std::string>& origin, int port);
 
-// Whether `query` (a request's query string; null: none) carries token=`token`.
-bool live_token_matches(const char* query, const std::string& token);
+// Whether `host` (a request's Host header) names this server on `port`:
+// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80).
+// A page of another name that resolves to 127.0.0.1 (DNS rebinding) is refused.
+bool live_host_allowed(const std::string& host, int port);
+
+// Whether `query` (a request's query string, every byte of it; none: not
+// given) carries token=`token`.
+bool live_token_matches(const std::optional<std::string>& query, const std::string& token);
 
 // One line to stderr, at most kLiveLogPerSecond a second from the whole
 // program: the rest are counted, and live_log_flush() (or the next line once

@@ -171,25 +171,33 @@ TEST_CASE("live knob declarations refuse a bad range and a repeated name and wid
   CHECK(knobs.json().find(R"("integer":true)") != std::string::npos);
 }
 
-TEST_CASE("live server accepts only the run's token and its own Origin", "[live]") {
+TEST_CASE("live server accepts only the run's token, its own Origin and its own Host", "[live]") {
   const std::string token = cl::live_token();
   CHECK(token.size() == 32);
   CHECK(token != cl::live_token());  // 128 random bits: two draws differ
   CHECK(cl::live_token_matches(("token=" + token).c_str(), token));
   CHECK(cl::live_token_matches(("a=1&token=" + token + "&b=2").c_str(), token));
-  CHECK_FALSE(cl::live_token_matches(nullptr, token));
+  CHECK_FALSE(cl::live_token_matches(std::nullopt, token));
+  CHECK_FALSE(cl::live_token_matches(std::string("token=" + token + '\0' + "x"), token));  // every byte counts
   CHECK_FALSE(cl::live_token_matches("", token));
   CHECK_FALSE(cl::live_token_matches(("token=" + token + "x").c_str(), token));
   CHECK_FALSE(cl::live_token_matches(("token=" + token.substr(1)).c_str(), token));
   CHECK_FALSE(cl::live_token_matches(("xtoken=" + token).c_str(), token));
   CHECK_FALSE(cl::live_token_matches("token=", ""));
-  CHECK(cl::live_origin_allowed(nullptr, 8123));
+  CHECK(cl::live_origin_allowed(std::nullopt, 8123));
   CHECK(cl::live_origin_allowed("http://127.0.0.1:8123", 8123));
   CHECK(cl::live_origin_allowed("http://localhost:8123", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8124", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8123.evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("null", 8123));
+  CHECK_FALSE(cl::live_origin_allowed(std::string("http://127.0.0.1:8123\0.evil.example", 35), 8123));  // every byte counts
+  CHECK(cl::live_host_allowed("127.0.0.1:8123", 8123));
+  CHECK(cl::live_host_allowed("localhost:8123", 8123));
+  CHECK_FALSE(cl::live_host_allowed("evil.example:8123", 8123));  // DNS rebinding: another name on 127.0.0.1
+  CHECK_FALSE(cl::live_host_allowed("127.0.0.1", 8123));
+  CHECK_FALSE(cl::live_host_allowed("127.0.0.1:81234", 8123));
+  CHECK(cl::live_host_allowed("localhost", 80));
 }
 
 // Inputs the fuzzer (fuzz/fuzz_live.cpp) found to break the parser, kept in
