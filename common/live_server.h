@@ -2,14 +2,18 @@
 // The live mode's server (docs/DESIGN.md §3, "The live mode"): a small HTTP
 // and WebSocket (RFC 6455) server on 127.0.0.1 only, one thread with
 // non-blocking sockets and poll(). GET /?token=T serves the page, /ws?token=T
-// is the page's WebSocket; neither answers without the run's token (403), and
-// a WebSocket whose Origin is not this server's is refused (403).
+// is the page's WebSocket; neither answers without the run's token (403). A
+// request whose Host is not this server's (403), one that gives a header the
+// server reads twice (400), a head over kRequestCap (431) and a WebSocket
+// whose Origin is not this server's (403) are refused too.
 //
 // One slow or noisy client must never stall the run or another client, so:
 // the live loop (common/live.h) never touches a socket (it fills per-client
 // outboxes; a frame waiting replaces the one before, the newest wins); a
-// client whose outbox does not drain for kStalledSeconds, or whose text
-// waiting passes kOutboxBytes, is dropped with one line; each client's
+// client whose outbox does not drain for kStalledSeconds, or with more than
+// kOutboxBytes queued toward it (everything but its frame), is dropped with
+// one line; one pending pong answers its pings, and at most
+// kControlsPerSecond control frames a second are read from it; each client's
 // messages wait in its own queue of at most kInboundPerClient, and while it is
 // full the server reads no more from that client (TCP holds the rest, so
 // nothing is lost, an ack included); take_inbound takes from every client in
