@@ -1,5 +1,6 @@
 #include "common/live.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -236,9 +237,10 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     }
   };
 
-  // While the lab's step runs (stepping), what it reads (the state, the knobs) is its own: the changes a
-  // page asks for then wait for its end, in order; a drag's new target replaces that of the drag
-  // waiting before it (the same page, the same particle), and a page has at most kWaitingPerClient waiting.
+  // While the lab's step runs (stepping), what it reads (the state, the knobs, the scene) is its own: the
+  // changes a page asks for then wait for its end, in order, and so do the pages that come (their hello)
+  // and go; a drag's new target replaces that of the drag waiting before it (the same page, the same
+  // particle), and a page has at most kWaitingPerClient changes waiting.
   bool stepping = false;
   struct Waiting {
     LiveInbound inbound;
@@ -265,12 +267,20 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   };
 
   auto apply = [&](const LiveInbound& inbound) {
-    if (inbound.opened) {
-      hello(inbound.client);
+    if ((inbound.opened || inbound.closed) && stepping) {  // the hello reads the scene, which the lab's step may touch
+      const auto mine = [&inbound](const Waiting& entry) { return entry.inbound.client == inbound.client; };
+      const bool greeted_later = std::any_of(waiting.begin(), waiting.end(), [&](const Waiting& entry) {
+        return mine(entry) && entry.inbound.opened;
+      });
+      if (inbound.closed && greeted_later) {  // came and went during the step: nothing of it is left to do
+        waiting.erase(std::remove_if(waiting.begin(), waiting.end(), mine), waiting.end());
+      } else {
+        waiting.push_back(Waiting{inbound, {}});
+      }
       return;
     }
-    if (inbound.closed && stepping) {
-      waiting.push_back(Waiting{inbound, {}});
+    if (inbound.opened) {
+      hello(inbound.client);
       return;
     }
     if (inbound.closed) {
