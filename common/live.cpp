@@ -1,15 +1,24 @@
 #include "common/live.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <functional>
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <mutex>
 #include <set>
 #include <sstream>
+#include <stdexcept>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -55,6 +64,76 @@ struct Hold {
 constexpr std::size_t kTrail = 4;
 
 using Clock = std::chrono::steady_clock;
+
+// How long a stop (the page's, Ctrl-C, SIGTERM) waits for the step under way
+// before the run ends without it.
+constexpr double kStopGraceSeconds = 0.5;
+// The most changes (a drag, a pin, a knob, a reset) a page may have waiting
+// for the step under way; more are refused.
+constexpr std::size_t kWaitingPerClient = 64;
+
+// The lab's step, on a thread of its own: the live loop goes on taking the
+// pages' messages and watching for a stop while it runs, however long it takes
+// (the student's code cannot be asked to look at a stop flag).
+class StepThread {
+ public:
+  StepThread() : thread_([this] { work(); }) {}
+  ~StepThread() {  // only when no job runs (run_live ends the process rather than wait for one)
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      quit_ = true;
+    }
+    wake_.notify_all();
+    thread_.join();
+  }
+  StepThread(const StepThread&) = delete;
+  StepThread& operator=(const StepThread&) = delete;
+
+  void start(std::function<void()> job) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      job_ = std::move(job);
+      done_ = false;
+    }
+    wake_.notify_all();
+  }
+  // Whether the job has ended, waiting up to `seconds`; rethrows what it threw (NotImplemented: exit 3).
+  bool wait(double seconds) {
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (!finished_.wait_for(lock, std::chrono::duration<double>(seconds), [this] { return done_; })) return false;
+    if (error_) std::rethrow_exception(std::exchange(error_, nullptr));
+    return true;
+  }
+
+ private:
+  void work() {
+    std::unique_lock<std::mutex> lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [this] { return quit_ || job_; });
+      if (quit_) return;
+      std::function<void()> job = std::move(job_);
+      job_ = nullptr;
+      lock.unlock();
+      std::exception_ptr error;
+      try {
+        job();
+      } catch (...) {
+        error = std::current_exception();
+      }
+      lock.lock();
+      error_ = error;
+      done_ = true;
+      finished_.notify_all();
+    }
+  }
+
+  std::mutex mutex_;
+  std::condition_variable wake_, finished_;
+  std::function<void()> job_;
+  std::exception_ptr error_;
+  bool done_ = true, quit_ = false;
+  std::thread thread_;  // last: started once the rest is ready
+};
 
 }  // namespace
 
@@ -126,7 +205,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
 
   auto send_error = [&](int client, const std::string& line) {
     live_log(line);  // a page that floods the run with bad messages gets its answers; stderr a summary
-    server.send_text(client, nlohmann::json{{"type", "error"}, {"text", line}}.dump());
+    server.send_text(client, live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}));
   };
   auto release = [&](std::map<int, Hold>::iterator hold) {
     const int p = hold->first;
@@ -148,18 +227,58 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     for (const Triangle& triangle : scene.triangles) {
       triangles.push_back(triangle.i), triangles.push_back(triangle.j), triangles.push_back(triangle.k);
     }
-    server.send_text(client, nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
+    server.send_text(client, live_json_text(nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
                                             {"method", run.method}, {"particles", n}, {"springs", springs},
                                             {"triangles", triangles}, {"rest_lengths", rest}, {"knobs", nlohmann::json::parse(knobs.json())},
                                             {"energy_name", run.energy_name}, {"command", command_line()},
-                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}
-                                 .dump());
+                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}));
     if (!problem.empty()) {  // a page opened after the run stopped sees why (its frame follows: the last good one)
-      server.send_text(client, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
+      server.send_text(client, live_json_text(nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}));
     }
   };
 
+  // While the lab's step runs (stepping), what it reads (the state, the knobs, the scene) is its own: the
+  // changes a page asks for then wait for its end, in order, and so do the pages that come (their hello)
+  // and go; a drag's new target replaces that of the drag waiting before it (the same page, the same
+  // particle), and a page has at most kWaitingPerClient changes waiting.
+  bool stepping = false;
+  struct Waiting {
+    LiveInbound inbound;
+    LiveCommand command;
+  };
+  std::vector<Waiting> waiting;
+  auto wait_for_step = [&](const LiveInbound& inbound, const LiveCommand& command) {
+    std::size_t mine = 0;
+    Waiting* last = nullptr;
+    for (Waiting& entry : waiting) {
+      if (entry.inbound.client == inbound.client) ++mine, last = &entry;
+    }
+    if (last != nullptr && !last->inbound.closed && last->command.kind == LiveCommandKind::kDrag &&
+        command.kind == LiveCommandKind::kDrag && last->command.particle == command.particle) {
+      last->inbound.text = inbound.text;
+      last->command = command;
+      return;
+    }
+    if (mine >= kWaitingPerClient) {
+      return send_error(inbound.client, "live: a step is under way and " + std::to_string(mine) +
+                                            " changes of this page wait for it; this one is not made");
+    }
+    waiting.push_back(Waiting{inbound, command});
+  };
+
   auto apply = [&](const LiveInbound& inbound) {
+    if ((inbound.opened || inbound.closed) && stepping) {  // the hello reads the scene, which the lab's step may touch
+      const auto mine = [&inbound](const Waiting& entry) { return entry.inbound.client == inbound.client; };
+      const bool greeted_later = std::any_of(waiting.begin(), waiting.end(), [&](const Waiting& entry) {
+        return mine(entry) && entry.inbound.opened;
+      });
+      if (inbound.closed && greeted_later) {  // came and went during the step: nothing of it is left to do
+        waiting.erase(std::remove_if(waiting.begin(), waiting.end(), mine), waiting.end());
+      } else {
+        waiting.push_back(Waiting{inbound, {}});
+      }
+      return;
+    }
     if (inbound.opened) {
       hello(inbound.client);
       return;
@@ -177,6 +296,11 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     const LiveParse parse = parse_live_message(inbound.text, knobs, n);
     if (!parse.ok()) return send_error(inbound.client, parse.error);
     const LiveCommand& command = parse.command;
+    const LiveCommandKind kind = command.kind;
+    if (stepping && (kind == LiveCommandKind::kReset || kind == LiveCommandKind::kSet || kind == LiveCommandKind::kDrag ||
+                     kind == LiveCommandKind::kRelease || kind == LiveCommandKind::kPin)) {
+      return wait_for_step(inbound, command);
+    }
     const int p = command.particle;
     switch (command.kind) {
       case LiveCommandKind::kPause: paused = true; break;
@@ -245,13 +369,80 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     ++version;
   };
 
+  auto take_messages = [&] {
+    for (const LiveInbound& inbound : server.take_inbound()) {
+      try {
+        apply(inbound);
+      } catch (const std::exception& error) {  // one message's failure is its page's error, never the run's end
+        send_error(inbound.client, std::string("live: a message could not be handled: ") + error.what());
+      }
+    }
+  };
+
+  // The end of the run: its line on stdout, the summary of `final_state`.
+  auto end_run = [&](Particles& final_state) {
+    live_log_flush(true);
+    for (auto& [p, hold] : holds) final_state.inv_mass[p] = hold.inv_mass;
+    std::printf("%s: live run ended after %d frames (%.3g s of simulated time, %.3e s per frame)\n", run.lab.c_str(),
+                steps_done, time, steps_done > 0 ? seconds / steps_done : 0.0);
+    if (!summary_path.empty()) {
+      RunSummary summary = stepping_summary(run.lab, run.method, scene, final_state, strain, seconds);
+      summary.steps = steps_done;
+      summary.dt = dt_now();
+      summary.extra["live"] = true;
+      summary.extra["frames"] = frame;
+      nlohmann::ordered_json values = nlohmann::ordered_json::object();
+      for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
+      summary.extra["knobs"] = values;
+      summary.extra["problem"] = problem;
+      write_summary(summary_path, summary);
+    }
+  };
+
+  StepThread stepper;
+  Particles before = state;  // the state before the step under way: the summary's, should a stop end it
   auto step = [&] {
-    const Timer change_timer;
-    if (changed && run.changed) rebuilt = run.changed(knobs);
+    const bool rebuild = changed && run.changed;
     changed = false;
-    const double change_seconds = change_timer.seconds();  // a refactorization: the page says this step cost more
-    const Timer timer;
-    const StepVerdict verdict = run.step(knobs);
+    before = state;
+    double change_seconds = 0.0, step_seconds = 0.0;
+    StepVerdict verdict;
+    std::string job_rebuilt;
+    stepper.start([&] {
+      const Timer change_timer;
+      if (rebuild) job_rebuilt = run.changed(knobs);
+      change_seconds = change_timer.seconds();  // a refactorization: the page says this step cost more
+      const Timer timer;
+      verdict = run.step(knobs);
+      step_seconds = timer.seconds();
+    });
+    stepping = true;
+    const Timer under_way;
+    double stop_seen = -1.0;  // when a stop came, s into the step
+    while (!stepper.wait(0.02)) {  // the step goes on: the loop takes messages and watches for a stop
+      take_messages();
+      live_log_flush();
+      if ((stop || live_stop_requested) && stop_seen < 0.0) stop_seen = under_way.seconds();
+      if (stop_seen >= 0.0 && under_way.seconds() > stop_seen + kStopGraceSeconds) {
+        // The step cannot be interrupted (it is the lab's code) and the run does not wait for it: the
+        // summary is of the last completed step, and the process ends here, the step's thread with it.
+        live_log("live: stopped during the step after frame " + std::to_string(frame) + " (under way for " +
+                 std::to_string(int(under_way.seconds())) + " s): the run ends without it");
+        try {
+          end_run(before);
+        } catch (const std::exception& error) {
+          std::fprintf(stderr, "%s: error: %s\n", run.lab.c_str(), error.what());
+          std::fflush(stdout);
+          std::fflush(stderr);
+          std::_Exit(2);
+        }
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::_Exit(0);
+      }
+    }
+    stepping = false;
+    rebuilt = job_rebuilt;
     stepped_with = knobs;
     for (auto& [p, hold] : holds) {  // a held particle is where the page holds it, whatever the step did
       state.x.col(p) = hold.target;
@@ -261,7 +452,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       if (hold.trail.size() > kTrail) hold.trail.erase(hold.trail.begin()), hold.trail_dt.erase(hold.trail_dt.begin());
     }
     previous_step_seconds = last_step_seconds;
-    last_step_seconds = (verdict.seconds >= 0.0 ? verdict.seconds : timer.seconds()) + change_seconds;
+    last_step_seconds = (verdict.seconds >= 0.0 ? verdict.seconds : step_seconds) + change_seconds;
     seconds += last_step_seconds;
     if (verdict.taken) ++frame, ++steps_done, time += dt_now();
     if (!rebuilt.empty()) last_rebuilt = rebuilt, last_rebuilt_frame = frame;
@@ -287,9 +478,16 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
       paused = problem_paused = true;
       problem_line = "live: frame " + std::to_string(frame) + ": " + problem + " (paused; reset to go on)";
       live_log(problem_line);
-      server.send_text(-1, nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}.dump());
+      server.send_text(-1, live_json_text(nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}));
     }
     ++version;
+    for (Waiting& entry : std::exchange(waiting, {})) {  // the changes asked for while it ran, in order
+      try {
+        apply(entry.inbound);
+      } catch (const std::exception& error) {
+        send_error(entry.inbound.client, std::string("live: a message could not be handled: ") + error.what());
+      }
+    }
   };
 
   // A frame with a non-finite value is never sent: every page gets the last good positions (and a page
@@ -317,13 +515,12 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
           held.push_back({{"particle", p}, {"x", {state.x(0, p), state.x(1, p), state.x(2, p)}}});
         }
         const double shown_energy = std::isfinite(energy_now) ? energy_now : 0.0;
-        status = nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
+        status = live_json_text(nlohmann::json{{"type", "frame"}, {"frame", frame}, {"time", time}, {"step_seconds", last_step_seconds},
                                 {"previous_step_seconds", previous_step_seconds}, {"refactored", !rebuilt.empty()}, {"rebuilt", rebuilt},
                                 {"last_rebuilt", last_rebuilt}, {"last_rebuilt_frame", last_rebuilt_frame},
                                 {"max_strain", std::isfinite(strain.max) ? strain.max : 0.0}, {"energy", shown_energy},
                                 {"paused", paused}, {"speed", speed}, {"knobs", values}, {"step_knobs", used}, {"pinned", pinned},
-                                {"held", held}, {"problem", problem}, {"clients", server.clients()}}
-                     .dump();
+                                {"held", held}, {"problem", problem}, {"clients", server.clients()}});
       }
       server.send_frame(client, status, data);
       sent[client] = version;
@@ -331,7 +528,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   };
 
   while (!stop && !live_stop_requested) {
-    for (const LiveInbound& inbound : server.take_inbound()) apply(inbound);
+    take_messages();
     if (stop) break;
     const Clock::time_point now = Clock::now();
     if (step_once || (!paused && problem.empty() && now >= next_due)) {
@@ -347,25 +544,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     const double wait = paused ? 0.05 : std::chrono::duration<double>(next_due - Clock::now()).count();
     server.wait_inbound(std::min(std::max(wait, 0.0), 0.05));
   }
-  live_log_flush(true);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
-  for (auto& [p, hold] : holds) state.inv_mass[p] = hold.inv_mass;
-
-  std::printf("%s: live run ended after %d frames (%.3g s of simulated time, %.3e s per frame)\n", run.lab.c_str(),
-              steps_done, time, steps_done > 0 ? seconds / steps_done : 0.0);
-  if (!summary_path.empty()) {
-    RunSummary summary = stepping_summary(run.lab, run.method, scene, state, strain, seconds);
-    summary.steps = steps_done;
-    summary.dt = dt_now();
-    summary.extra["live"] = true;
-    summary.extra["frames"] = frame;
-    nlohmann::ordered_json values = nlohmann::ordered_json::object();
-    for (const Knob& knob : knobs.all()) values[knob.name] = knob.value;
-    summary.extra["knobs"] = values;
-    summary.extra["problem"] = problem;
-    write_summary(summary_path, summary);
-  }
+  end_run(state);
   return 0;
 }
 

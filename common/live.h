@@ -6,7 +6,10 @@
 // does (common/frame_loop.h: the step's own problem, health, the energy
 // verdict); a problem pauses the run and the page shows its one line; a frame
 // with a non-finite value is never sent. Runs until Ctrl-C, SIGTERM or the
-// page's "stop", then writes --summary (when given) and returns 0.
+// page's "stop", then writes --summary (when given) and returns 0. The step
+// runs on a thread of its own, so a stop is seen during a step of minutes: it
+// waits 0.5 s for the step, then writes the summary of the last completed
+// step and ends the process with exit 0.
 #include <functional>
 #include <string>
 #include <utility>

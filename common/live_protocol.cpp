@@ -28,17 +28,19 @@ const std::vector<std::pair<const char*, std::vector<const char*>>>& live_comman
   return fields;
 }
 
-// A finite number from `value`, or the reason it is not one.
 // A name from the message, as an error line may quote it: at most 40 bytes,
-// control characters (a "\n" in a JSON string) as '?', so the line stays one line.
+// cut where a character starts (a cut inside a UTF-8 character made the
+// reply's JSON invalid), control characters (a "\n" in a JSON string) as '?',
+// so the line stays one line.
 std::string quoted(const std::string& text) {
-  std::string shown = text.substr(0, 40);
+  std::string shown = live_cut_utf8(text, 40);
   for (char& c : shown) {
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
   }
   return "'" + shown + "'";
 }
 
+// A finite number from `value`, or the reason it is not one.
 std::string read_finite(const nlohmann::json& value, const char* key, double& out) {
   if (!value.is_number()) return std::string(key) + ": not a number";
   out = value.get<double>();
@@ -59,6 +61,17 @@ std::string read_particle(const nlohmann::json& value, long long particles, int&
 }
 
 }  // namespace
+
+std::string live_cut_utf8(const std::string& text, std::size_t bytes) {
+  if (text.size() <= bytes) return text;
+  std::size_t cut = bytes;
+  while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0u) == 0x80u) --cut;  // a continuation byte
+  return text.substr(0, cut);
+}
+
+std::string live_json_text(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 Knobs::Knobs(std::initializer_list<Knob> knobs) : Knobs(std::vector<Knob>(knobs)) {}
 
@@ -95,7 +108,7 @@ std::string Knobs::json() const {
     list.push_back({{"name", knob.name}, {"unit", knob.unit}, {"low", knob.low}, {"high", knob.high},
                     {"value", knob.value}, {"integer", knob.integer}});
   }
-  return list.dump();
+  return live_json_text(list);
 }
 
 LiveParse parse_live_message(const std::string& text, const Knobs& knobs, long long particles) {

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
 
 namespace cl {
 
@@ -82,6 +83,14 @@ struct LiveParse {
   std::string error;
   bool ok() const { return error.empty(); }
 };
+
+// The first `bytes` bytes of UTF-8 `text`, fewer when that would cut a
+// character: the cut backs off to where a character starts.
+std::string live_cut_utf8(const std::string& text, std::size_t bytes);
+
+// `value` as JSON text for a client; never throws (a string that is not
+// UTF-8 has U+FFFD where its bad bytes were, where dump() would throw).
+std::string live_json_text(const nlohmann::json& value);
 
 // Parses and validates one message from the page against `knobs` and a scene
 // of `particles` particles. Never throws; never accepts a non-finite number.

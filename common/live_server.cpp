@@ -87,12 +87,19 @@ std::string lower(std::string text) {
   return text;
 }
 
+// A header's value as a stderr line may show it: at most 80 bytes, printable ASCII ('?' for the rest).
+std::string shown(const std::string& text) {
+  std::string out = text.substr(0, 80);
+  for (char& c : out) c = static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) >= 0x7f ? '?' : c;
+  return out;
+}
+
 std::string http_answer(int code, const char* reason, const std::string& body) {
   return "HTTP/1.1 " + std::to_string(code) + " " + reason + "\r\nContent-Type: text/plain; charset=utf-8\r\n" +
          "Content-Length: " + std::to_string(body.size()) + "\r\nConnection: close\r\nCache-Control: no-store\r\n\r\n" + body;
 }
 
-std::string error_message(const std::string& line) { return nlohmann::json{{"type", "error"}, {"text", line}}.dump(); }
+std::string error_message(const std::string& line) { return live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}); }
 
 struct LogState {
   std::mutex mutex;
@@ -201,16 +208,20 @@ std::string live_token() {
   return token;
 }
 
-bool live_origin_allowed(const char* origin, int port) {
-  if (origin == nullptr) return true;
-  const std::string given(origin);
+bool live_origin_allowed(const std::optional<std::string>& origin, int port) {
+  if (!origin) return true;
   const std::string tail = ":" + std::to_string(port);
-  return given == "http://127.0.0.1" + tail || given == "http://localhost" + tail;
+  return *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail;
 }
 
-bool live_token_matches(const char* query, const std::string& token) {
-  if (query == nullptr || token.empty()) return false;
-  const std::string text(query);
+bool live_host_allowed(const std::string& host, int port) {
+  const std::string tail = ":" + std::to_string(port);
+  return host == "127.0.0.1" + tail || host == "localhost" + tail || (port == 80 && (host == "127.0.0.1" || host == "localhost"));
+}
+
+bool live_token_matches(const std::optional<std::string>& query, const std::string& token) {
+  if (!query || token.empty()) return false;
+  const std::string& text = *query;
   std::size_t start = 0;
   while (start <= text.size()) {
     const std::size_t end = std::min(text.find('&', start), text.size());
@@ -258,6 +269,11 @@ struct LiveServer::Loop {
     bool refusing = false;        // the message in progress is refused: its frames are discarded
     std::uint64_t skip = 0;       // payload bytes of a refused frame still to discard
     bool spoke = false;           // kSocket: it has sent something since its handshake
+    std::string pong;             // the payload of the newest ping not answered yet (one pong answers them all)
+    bool pong_due = false;
+    std::size_t out_frame = 0;    // the bytes of `out` that are a frame (bounded: the newest wins), not counted
+    Clock::time_point controls_since;  // the second in which `controls` control frames were read
+    int controls = 0;
   };
 
   LiveServer* server = nullptr;
@@ -421,7 +437,6 @@ void LiveServer::Loop::run() {
       if (read(shared->wake_fd, &count, sizeof count) < 0) { /* nothing to read: a spurious wake */ }
     }
     const Clock::time_point now = Clock::now();
-    if (polled[1].revents & POLLIN) accept_new(now);
     for (std::size_t i = 0; i < polled_connections.size(); ++i) {
       const auto connection = polled_connections[i];
       const short revents = polled[i + 2].revents;
@@ -438,17 +453,21 @@ void LiveServer::Loop::run() {
       fill(*connection);
       if (!write_some(*connection, now)) close_connection(connection, "");
     }
+    // After the round, never before it: a new comer may close the oldest pending connection, which the
+    // round would have touched after its closing (a use after free).
+    if (polled[1].revents & POLLIN) accept_new(now);
     // Deadlines, and what the loop's side asked (an eviction, a client whose outbox overflowed).
     for (auto connection = connections.begin(); connection != connections.end();) {
       const auto next = std::next(connection);
       const bool waiting = connection->out_at < connection->out.size();
       bool evict = false;
-      std::size_t text_bytes = 0;
+      // Every byte queued toward it but its frames (the newest replaces the one waiting: they cannot pile up).
+      std::size_t queued = connection->out.size() - connection->out_at - std::min(connection->out_frame, connection->out.size() - connection->out_at);
       if (connection->state == State::kSocket) {
         const std::lock_guard<std::mutex> lock(shared->mutex);
         const Shared::Client& client = shared->clients[connection->client];
         evict = client.evict;
-        text_bytes = client.text_bytes;
+        queued += client.text_bytes + (connection->pong_due ? connection->pong.size() + 2 : 0);
       }
       const std::string id = "page " + std::to_string(connection->client);
       if (connection->state == State::kRequest && since(connection->opened, now) > kRequestSeconds) {
@@ -458,9 +477,9 @@ void LiveServer::Loop::run() {
       } else if (connection->state == State::kSocket) {
         if (evict) {
           close_connection(connection, "live: " + id + " closed: a new page came and it was heard from least recently");
-        } else if (text_bytes > kOutboxBytes) {
+        } else if (queued > kOutboxBytes) {
           close_connection(connection, "live: " + id + " dropped: over " + std::to_string(kOutboxBytes >> 20) +
-                                           " MB of messages waiting for it (it reads nothing)");
+                                           " MB waiting for it (it reads too little of what it asks for)");
         } else if (waiting && since(connection->progress, now) > kStalledSeconds) {
           close_connection(connection, "live: " + id + " dropped: it took nothing off its socket for " +
                                            std::to_string(int(kStalledSeconds)) + " s");
@@ -471,6 +490,7 @@ void LiveServer::Loop::run() {
           connection->pinged = now;
           connection->out = websocket_frame(kOpPing, "", 0);
           connection->out_at = 0;
+          connection->out_frame = 0;
         }
       }
       connection = next;
@@ -533,13 +553,15 @@ void LiveServer::Loop::refuse(Connection& connection, int code, const char* reas
 
 void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point now) {
   const std::size_t end = connection.in.find("\r\n\r\n");
-  if (end == std::string::npos) {
-    if (connection.in.size() > kRequestCap) refuse(connection, 431, "Request Header Fields Too Large", "live: a request head over 8 KiB", "");
-    return;
+  // Over the cap however it came: still coming, or whole in one write (a 60 kB head used to be served).
+  if (end == std::string::npos ? connection.in.size() > kRequestCap : end + 4 > kRequestCap) {
+    return refuse(connection, 431, "Request Header Fields Too Large", "live: a request head over 8 KiB", "");
   }
+  if (end == std::string::npos) return;
   const std::string head = connection.in.substr(0, end);
   connection.in.erase(0, end + 4);
   std::map<std::string, std::string> headers;
+  std::string repeated;  // a header this server reads, given twice (which one counts is anybody's guess)
   std::size_t line_end = head.find("\r\n");
   const std::string request_line = head.substr(0, line_end);
   while (line_end != std::string::npos) {
@@ -551,7 +573,9 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
     std::string value = line.substr(colon + 1);
     value.erase(0, std::min(value.find_first_not_of(" \t"), value.size()));
     value.erase(value.find_last_not_of(" \t") + 1);
-    headers[lower(line.substr(0, colon))] = value;
+    const std::string name = lower(line.substr(0, colon));
+    const bool read = name == "host" || name == "origin" || name == "upgrade" || name.rfind("sec-websocket-", 0) == 0;
+    if (!headers.emplace(name, value).second && read) repeated = name;
   }
   const std::size_t space = request_line.find(' ');
   const std::size_t space2 = request_line.find(' ', space == std::string::npos ? 0 : space + 1);
@@ -561,9 +585,19 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
   const std::string path = target.substr(0, question);
   const std::string query = question == std::string::npos ? std::string() : target.substr(question + 1);
   if (method != "GET") return refuse(connection, 405, "Method Not Allowed", "live: only GET", "");
+  if (!repeated.empty()) {
+    return refuse(connection, 400, "Bad Request", "live: a header given twice (" + shown(repeated) + ")",
+                  "live: a request with two " + shown(repeated) + " headers, refused (400)");
+  }
+  const auto host = headers.find("host");
+  if (host == headers.end()) return refuse(connection, 400, "Bad Request", "live: a request without Host", "");
+  if (!live_host_allowed(host->second, server->port())) {
+    return refuse(connection, 403, "Forbidden", "live: a request for another host",
+                  "live: a request for the host '" + shown(host->second) + "', refused (403)");
+  }
   if (path != "/" && path != "/ws") return refuse(connection, 404, "Not Found", "live: not found (the page is /?token=...)", "");
   const bool upgrade = lower(headers["upgrade"]) == "websocket";
-  if (!live_token_matches(query.c_str(), server->token())) {
+  if (!live_token_matches(question == std::string::npos ? std::nullopt : std::optional<std::string>(query), server->token())) {
     return refuse(connection, 403, "Forbidden", "live: wrong or missing token (open the URL the program printed)",
                   path == "/" && !upgrade ? "live: a request for the page without the run's token, refused (403)"
                                           : "live: a WebSocket without the run's token, refused (403)");
@@ -577,11 +611,9 @@ void LiveServer::Loop::handle_request(Connection& connection, Clock::time_point 
     return;
   }
   const auto origin = headers.find("origin");
-  if (!live_origin_allowed(origin == headers.end() ? nullptr : origin->second.c_str(), server->port())) {
-    std::string shown = origin->second.substr(0, 80);
-    for (char& c : shown) c = static_cast<unsigned char>(c) < 0x20 ? '?' : c;
+  if (!live_origin_allowed(origin == headers.end() ? std::nullopt : std::optional<std::string>(origin->second), server->port())) {
     return refuse(connection, 403, "Forbidden", "live: a WebSocket from a foreign Origin",
-                  "live: a WebSocket from the foreign Origin '" + shown + "', refused (403)");
+                  "live: a WebSocket from the foreign Origin '" + shown(origin->second) + "', refused (403)");
   }
   if (!upgrade || headers["sec-websocket-key"].empty() || headers["sec-websocket-version"] != "13") {
     return refuse(connection, 400, "Bad Request", "live: /ws is a WebSocket (version 13)", "");
@@ -652,6 +684,10 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
     }
     connection.heard = now;
     const bool control = (header.opcode & 0x8) != 0;
+    if (control) {  // at most kControlsPerSecond, as its text is held to its queue: the rest wait in TCP
+      if (since(connection.controls_since, now) >= 1.0) connection.controls_since = now, connection.controls = 0;
+      if (connection.controls >= kControlsPerSecond) break;
+    }
     const std::size_t had = connection.refusing ? 0 : connection.message.size();
     if (!control && (header.opcode == kOpBinary || connection.refusing || had + header.length > kLiveMessageCap)) {
       // Refused by its header: the payload is discarded as it arrives, never held.
@@ -682,8 +718,10 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
       connection.state = State::kClosing;
       break;
     }
-    if (header.opcode == kOpPing) {
-      connection.out.append(websocket_frame(kOpPong, payload.data(), payload.size()));
+    if (control) ++connection.controls;
+    if (header.opcode == kOpPing) {  // answered when its socket has taken what it was given (fill)
+      connection.pong = std::move(payload);
+      connection.pong_due = true;
       continue;
     }
     if (header.opcode == kOpPong) continue;
@@ -703,14 +741,17 @@ void LiveServer::Loop::handle_frames(Connection& connection, Clock::time_point n
 // The client's outbox into its socket's buffer, when that is empty: texts first, then the newest frame.
 void LiveServer::Loop::fill(Connection& connection) {
   if (connection.state != State::kSocket) return;
-  if (connection.out_at == connection.out.size()) connection.out.clear(), connection.out_at = 0;
+  if (connection.out_at == connection.out.size()) connection.out.clear(), connection.out_at = 0, connection.out_frame = 0;
   if (!connection.out.empty()) return;
+  if (connection.pong_due) connection.out = websocket_frame(kOpPong, connection.pong.data(), connection.pong.size());
+  connection.pong_due = false;
   const std::lock_guard<std::mutex> lock(shared->mutex);
   Shared::Client& client = shared->clients[connection.client];
   for (std::string& text : client.texts) connection.out += text;
   client.texts.clear();
   client.text_bytes = 0;
   connection.out += client.frame;
+  connection.out_frame = client.frame.size();
   client.frame.clear();
 }
 

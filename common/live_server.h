@@ -2,14 +2,18 @@
 // The live mode's server (docs/DESIGN.md §3, "The live mode"): a small HTTP
 // and WebSocket (RFC 6455) server on 127.0.0.1 only, one thread with
 // non-blocking sockets and poll(). GET /?token=T serves the page, /ws?token=T
-// is the page's WebSocket; neither answers without the run's token (403), and
-// a WebSocket whose Origin is not this server's is refused (403).
+// is the page's WebSocket; neither answers without the run's token (403). A
+// request whose Host is not this server's (403), one that gives a header the
+// server reads twice (400), a head over kRequestCap (431) and a WebSocket
+// whose Origin is not this server's (403) are refused too.
 //
 // One slow or noisy client must never stall the run or another client, so:
 // the live loop (common/live.h) never touches a socket (it fills per-client
 // outboxes; a frame waiting replaces the one before, the newest wins); a
-// client whose outbox does not drain for kStalledSeconds, or whose text
-// waiting passes kOutboxBytes, is dropped with one line; each client's
+// client whose outbox does not drain for kStalledSeconds, or with more than
+// kOutboxBytes queued toward it (everything but its frame), is dropped with
+// one line; one pending pong answers its pings, and at most
+// kControlsPerSecond control frames a second are read from it; each client's
 // messages wait in its own queue of at most kInboundPerClient, and while it is
 // full the server reads no more from that client (TCP holds the rest, so
 // nothing is lost, an ack included); take_inbound takes from every client in
@@ -23,6 +27,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,6 +84,7 @@ class LiveServer {
   static constexpr double kStalledSeconds = 5.0;
   static constexpr double kPingSeconds = 2.0;
   static constexpr double kSilentSeconds = 20.0;  // a WebSocket that answers nothing, not even a ping
+  static constexpr int kControlsPerSecond = 32;    // control frames (ping, pong) read from one client a second
 
   struct Shared;  // the queues both threads touch (live_server.cpp)
   struct Loop;    // the server thread's own state
@@ -93,13 +99,19 @@ class LiveServer {
 // 128 random bits as 32 hex digits (std::random_device).
 std::string live_token();
 
-// Whether `origin` (the WebSocket's Origin header; null: none given) may
-// connect to a server on `port`: none (a client that is not a browser), or
-// http://127.0.0.1:PORT or http://localhost:PORT exactly.
-bool live_origin_allowed(const char* origin, int port);
+// Whether `origin` (the WebSocket's Origin header, every byte of it; none:
+// not given) may connect to a server on `port`: none (a client that is not a
+// browser), or http://127.0.0.1:PORT or http://localhost:PORT exactly.
+bool live_origin_allowed(const std::optional<std::string>& origin, int port);
 
-// Whether `query` (a request's query string; null: none) carries token=`token`.
-bool live_token_matches(const char* query, const std::string& token);
+// Whether `host` (a request's Host header) names this server on `port`:
+// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80).
+// A page of another name that resolves to 127.0.0.1 (DNS rebinding) is refused.
+bool live_host_allowed(const std::string& host, int port);
+
+// Whether `query` (a request's query string, every byte of it; none: not
+// given) carries token=`token`.
+bool live_token_matches(const std::optional<std::string>& query, const std::string& token);
 
 // One line to stderr, at most kLiveLogPerSecond a second from the whole
 // program: the rest are counted, and live_log_flush() (or the next line once

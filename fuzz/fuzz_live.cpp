@@ -1,15 +1,17 @@
 // libFuzzer target for the live mode's message parser (common/live_protocol.h,
 // docs/DESIGN.md §3, "The live mode"): any bytes are either a command whose
 // values are in their ranges and finite, or refused in one line starting
-// "live: ". A crash, a sanitizer report or a broken promise is a bug;
-// ./course fuzz copies the input into tests/common/live_regressions/, which
-// the unit tests replay.
+// "live: " in valid UTF-8 (the page's reply is JSON built from it). A crash,
+// a sanitizer report or a broken promise is a bug; ./course fuzz copies the
+// input into tests/common/live_regressions/, which the unit tests replay.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "common/live_protocol.h"
 
@@ -19,6 +21,11 @@ const char* broken_promise(const std::string& text, const cl::LiveParse& parse, 
   if (!parse.ok()) {
     if (parse.error.rfind("live: ", 0) != 0) return "a refusal that does not start with 'live: '";
     if (parse.error.find('\n') != std::string::npos) return "a refusal of more than one line";
+    try {
+      (void)nlohmann::json(parse.error).dump();
+    } catch (const nlohmann::json::exception&) {
+      return "a refusal that is not UTF-8 (its JSON reply cannot be built)";
+    }
     return nullptr;
   }
   const cl::LiveCommand& command = parse.command;

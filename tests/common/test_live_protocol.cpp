@@ -7,9 +7,12 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "common/live.h"
 #include "common/live_protocol.h"
@@ -30,6 +33,7 @@ void require_refused(const std::string& text, const std::string& expected) {
   CHECK(parse.error.rfind("live: ", 0) == 0);
   CHECK(parse.error.find('\n') == std::string::npos);
   CHECK(parse.error.find(expected) != std::string::npos);
+  CHECK_NOTHROW(nlohmann::json(parse.error).dump());  // valid UTF-8: the reply to the page is built from it
 }
 
 cl::LiveCommand accepted(const std::string& text) {
@@ -77,6 +81,25 @@ TEST_CASE("live protocol refuses malformed JSON, a non-object and an unknown com
   require_refused(R"({"cmd": "drag", "particle": 3})", "missing \"x\"");
   require_refused(R"({"cmd": "line\nbreak"})", "unknown command 'line?break'");  // still one line
   require_refused(R"({"cmd": "pause", "a\u0000b": 1})", "unknown key 'a?b'");
+}
+
+// A quoted name is cut at 40 bytes; a cut inside a UTF-8 character made the
+// reply's JSON throw, and the program ended (exit 1) on one message.
+TEST_CASE("live protocol cuts a quoted name where a character starts", "[live]") {
+  const std::string a39(39, 'a');
+  require_refused(R"({"cmd": ")" + a39 + R"(\u00e9"})", "unknown command '" + a39 + "'");
+  require_refused(R"({"cmd": ")" + a39 + "é\"}", "unknown command '" + a39 + "'");
+  require_refused(R"({"cmd": "pause", ")" + a39 + "é\": 1}", "unknown key '" + a39 + "'");
+  require_refused(R"({"cmd": "set", "knob": ")" + a39 + R"(é", "value": 1})", "unknown knob '" + a39 + "'");
+  require_refused(R"({"cmd": ")" + std::string(38, 'a') + "€\"}", "unknown command '" + std::string(38, 'a') + "'");
+  require_refused(R"({"cmd": ")" + std::string(37, 'a') + "😀\"}", "unknown command '" + std::string(37, 'a') + "'");
+  require_refused(R"({"cmd": ")" + std::string(36, 'a') + "😀\"}", "unknown command '" + std::string(36, 'a') + "😀'");
+  CHECK(cl::live_cut_utf8("é", 1).empty());
+  CHECK(cl::live_cut_utf8("aé", 2) == "a");
+  CHECK(cl::live_cut_utf8("aé", 3) == "aé");
+  CHECK(cl::live_cut_utf8("abc", 40) == "abc");
+  const std::string bad = "\xff\xfe";  // not UTF-8 at all: what a reply is built from never throws
+  CHECK(nlohmann::json::parse(cl::live_json_text(nlohmann::json{{"text", bad}}))["text"] == "\xef\xbf\xbd\xef\xbf\xbd");
 }
 
 TEST_CASE("live protocol refuses a key given twice and reads -0 as 0", "[live]") {
@@ -148,25 +171,33 @@ TEST_CASE("live knob declarations refuse a bad range and a repeated name and wid
   CHECK(knobs.json().find(R"("integer":true)") != std::string::npos);
 }
 
-TEST_CASE("live server accepts only the run's token and its own Origin", "[live]") {
+TEST_CASE("live server accepts only the run's token, its own Origin and its own Host", "[live]") {
   const std::string token = cl::live_token();
   CHECK(token.size() == 32);
   CHECK(token != cl::live_token());  // 128 random bits: two draws differ
   CHECK(cl::live_token_matches(("token=" + token).c_str(), token));
   CHECK(cl::live_token_matches(("a=1&token=" + token + "&b=2").c_str(), token));
-  CHECK_FALSE(cl::live_token_matches(nullptr, token));
+  CHECK_FALSE(cl::live_token_matches(std::nullopt, token));
+  CHECK_FALSE(cl::live_token_matches(std::string("token=" + token + '\0' + "x"), token));  // every byte counts
   CHECK_FALSE(cl::live_token_matches("", token));
   CHECK_FALSE(cl::live_token_matches(("token=" + token + "x").c_str(), token));
   CHECK_FALSE(cl::live_token_matches(("token=" + token.substr(1)).c_str(), token));
   CHECK_FALSE(cl::live_token_matches(("xtoken=" + token).c_str(), token));
   CHECK_FALSE(cl::live_token_matches("token=", ""));
-  CHECK(cl::live_origin_allowed(nullptr, 8123));
+  CHECK(cl::live_origin_allowed(std::nullopt, 8123));
   CHECK(cl::live_origin_allowed("http://127.0.0.1:8123", 8123));
   CHECK(cl::live_origin_allowed("http://localhost:8123", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8124", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("http://127.0.0.1:8123.evil.example", 8123));
   CHECK_FALSE(cl::live_origin_allowed("null", 8123));
+  CHECK_FALSE(cl::live_origin_allowed(std::string("http://127.0.0.1:8123\0.evil.example", 35), 8123));  // every byte counts
+  CHECK(cl::live_host_allowed("127.0.0.1:8123", 8123));
+  CHECK(cl::live_host_allowed("localhost:8123", 8123));
+  CHECK_FALSE(cl::live_host_allowed("evil.example:8123", 8123));  // DNS rebinding: another name on 127.0.0.1
+  CHECK_FALSE(cl::live_host_allowed("127.0.0.1", 8123));
+  CHECK_FALSE(cl::live_host_allowed("127.0.0.1:81234", 8123));
+  CHECK(cl::live_host_allowed("localhost", 80));
 }
 
 // Inputs the fuzzer (fuzz/fuzz_live.cpp) found to break the parser, kept in
@@ -182,6 +213,7 @@ TEST_CASE("live protocol replays the fuzzer's saved inputs", "[live]") {
     const cl::LiveParse parse = cl::parse_live_message(text.str(), lab04_knobs(), 256);
     CAPTURE(entry.path().string(), parse.error);
     CHECK((parse.ok() || (parse.error.rfind("live: ", 0) == 0 && parse.error.find('\n') == std::string::npos)));
+    CHECK_NOTHROW(nlohmann::json(parse.error).dump());
     ++replayed;
   }
   CHECK(replayed >= 1);  // the folder holds at least its seed

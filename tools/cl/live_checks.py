@@ -8,7 +8,9 @@ page's control (the next frames are stepped with it), a malformed message (the
 error line, and frames keep coming), a second client that drags and
 disconnects mid-drag (the server runs on), the refusals of a request without
 the token and of a foreign Origin, and the page's stop (exit 0, the summary
-with the new K)."""
+with the new K). Beside it, on programs of their own: the stress of
+tools/cl/live_stress.py, the handouts' live sections, then the hostile
+client's cases (check_hostile)."""
 import json
 import math
 import os
@@ -24,7 +26,7 @@ from pathlib import Path
 from .base import BIN, BUILD
 from .live import read_url
 from .live_handouts import check_handouts
-from .live_stress import FLOOD, check_stress
+from .live_stress import FLOOD, IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile, check_stress
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
                   "--enable-unsafe-swiftshader", "--window-size=800,600", "--remote-debugging-port=0",
@@ -261,7 +263,7 @@ def check_live(checks):
     # The stress test runs beside the browser's, on a program of its own: the two share the 20 s.
     stress = {}
 
-    def beside():  # the stress, then the handouts' live sections (each a program of its own)
+    def beside():  # the stress, the handouts' live sections, the hostile cases (each on programs of their own)
         try:
             stress.update(zip(("problems", "numbers"), check_stress(program)))
         except Exception as error:  # noqa: BLE001 (a thread's error is a check's problem, not a lost traceback)
@@ -272,6 +274,12 @@ def check_live(checks):
         except Exception as error:  # noqa: BLE001
             stress["handouts"] = [f"the handouts' live checks: {type(error).__name__}: {error}"]
         stress["handouts_seconds"] = time.monotonic() - handouts_started
+        hostile_started = time.monotonic()  # after the browser's check, mostly: its ping flood measures a rate
+        try:
+            stress["hostile"] = check_hostile(program, scratch)
+        except Exception as error:  # noqa: BLE001
+            stress["hostile"] = ([f"the hostile cases: {type(error).__name__}: {error}"], {})
+        stress["hostile_seconds"] = time.monotonic() - hostile_started
 
     stressing = threading.Thread(target=beside)
     stressing.start()
@@ -328,3 +336,18 @@ def check_live(checks):
                   f"live: the handouts' \"Try it live\" numbers and effects (labs 04, 06, 14) on the reference, driven "
                   f"over the page's socket ({stress.get('handouts_seconds', 0):.0f} s)",
                   stress.get("handouts", ["the handouts' live checks did not finish"]))
+    hostile_problems, numbers = stress.get("hostile", (["the hostile cases did not finish"], {}))
+
+    def seconds(key):
+        return "-" if numbers.get(key) is None else f"{numbers[key]:.2f} s"
+
+    checks.record(
+        "hostile" in stress and not hostile_problems,
+        f"live against a hostile local client ({stress.get('hostile_seconds', 0):.0f} s): names cut inside a UTF-8 "
+        f"character answered (not exit 1); a 60 kB head in one write 431, a foreign Host 403, none 400, two Origins "
+        f"400, a NUL inside Origin 403; {IDLE_SOCKETS} idle sockets, then the page and a hello within 2 s; a ping flood "
+        f"reading 64 kB every 0.3 s: RSS +{numbers.get('ping_rss_rise_mb', 0):.1f} MB (at most "
+        f"{PING_RSS_BYTES >> 20}), the honest page {numbers.get('ping_honest_fps')} frames/s (median, at least "
+        f"{PING_MIN_FPS}); SIGINT and the page's stop during a 1e8-iteration step: exit 0 with the summary after "
+        f"{seconds('SIGINT_seconds')} and {seconds('stop_seconds')} (at most 1 s)",
+        hostile_problems)

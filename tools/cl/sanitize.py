@@ -1,4 +1,6 @@
-"""./course sanitize: the whole test suite under ASan and UBSan (build/asan), and its CI check."""
+"""./course sanitize: the whole test suite under ASan and UBSan (build/asan), and its CI check;
+then lab 04's reference in live mode under the round-3 attacks (tools/cl/live_stress.py:
+check_hostile), whose server must stay clean too."""
 import argparse
 import atexit
 from concurrent.futures import ThreadPoolExecutor
@@ -20,6 +22,9 @@ SANITIZE_BUILD = BUILD / "asan"
 SANITIZE_FLAGS = "-Og -g1"  # with CL_SANITIZE's -fsanitize=address,undefined (CMakeLists.txt)
 
 
+SANITIZE_LIVE = "lab04_pbd_solution"  # the live server's attacks run on it (check_hostile)
+
+
 def sanitize_targets():
     """The whole test suite: common_tests and every lab's graded tests on its reference."""
     labs = [lab for lab, entry in manifest().items() if entry["reference"]]
@@ -29,8 +34,8 @@ def sanitize_targets():
 def run_sanitized(log=sys.stdout):
     """Build the test suite with -fsanitize=address,undefined (CMakeLists.txt: CL_SANITIZE)
     into BUILD/asan and run every test program there, every case (hidden ones too).
-    Return [(program, ok, summary line, report lines)]."""
-    return run_programs(build_sanitized(log))
+    Return [(program, ok, summary line, report lines)], the live attacks last."""
+    return run_programs(build_sanitized(log)) + [run_live()]
 
 
 def configure_sanitized(log=sys.stdout):
@@ -51,7 +56,8 @@ def configure_sanitized(log=sys.stdout):
 def build_sanitized(log=sys.stdout):
     """Configure (once) and build the sanitizer build's test programs; return their names."""
     targets = configure_sanitized(log)
-    build_targets(targets, build_dir=SANITIZE_BUILD, log=log, label="the test suite (-fsanitize=address,undefined)")
+    build_targets([*targets, SANITIZE_LIVE], build_dir=SANITIZE_BUILD, log=log,
+                  label=f"the test suite and {SANITIZE_LIVE} (-fsanitize=address,undefined)")
     return targets
 
 
@@ -70,7 +76,7 @@ class BackgroundSuite:
         self.output = tempfile.TemporaryFile(mode="w+")
         self.started = time.monotonic()
         self.process = subprocess.Popen(
-            ["nice", "-n", "10", *build_command(self.targets, SANITIZE_BUILD)],
+            ["nice", "-n", "10", *build_command([*self.targets, SANITIZE_LIVE], SANITIZE_BUILD)],
             cwd=ROOT, stdout=self.output, stderr=subprocess.STDOUT, text=True, start_new_session=True)
         atexit.register(self.stop)
         self.thread = threading.Thread(target=self.work, daemon=True)
@@ -86,7 +92,7 @@ class BackgroundSuite:
             if code != 0:
                 raise BuildFailure(self.targets, first_errors(text))
             start = time.monotonic()
-            self.results = run_programs(self.targets, nice=True)
+            self.results = run_programs(self.targets, nice=True) + [run_live(nice=True)]
             self.run_seconds = time.monotonic() - start
         except BaseException as error:  # handed to finish(), in the main thread
             self.error = error
@@ -126,6 +132,28 @@ def run_program(name, nice=False):
                    f"exit code {done.returncode}")
     return (name, ok, f"{summary.strip()} ({time.monotonic() - start:.1f} s)",
             report or ([] if ok else lines[-20:]))
+
+
+def run_live(nice=False):
+    """SANITIZE_LIVE built with the sanitizers, live, under check_hostile's attacks (about 10 s):
+    (name, ok, summary line, report lines). The ping flood's memory and rate are not asked there
+    (ASan's own memory and pace); a sanitizer report from any of its programs fails it."""
+    name = f"{SANITIZE_LIVE} --live"
+    try:
+        import websocket  # noqa: F401  (Debian's python3-websocket, which the attacks' honest page uses)
+    except ImportError:
+        return name, True, "skipped: python3-websocket is not installed (./course installs it)", []
+    from .live_stress import IDLE_SOCKETS, check_hostile
+    start = time.monotonic()
+    program = SANITIZE_BUILD / "bin" / SANITIZE_LIVE
+    with tempfile.TemporaryDirectory(prefix="cl-asan-live-") as work:
+        problems, numbers = check_hostile(program, work, start_seconds=60, bounded=False, env=sanitizer_env(leaks=True),
+                                          prefix=["nice", "-n", "10"] if nice else [])
+    report = grade.sanitizer_report(numbers.get("stderr", ""), ROOT)
+    ok = not problems and not report
+    return (name, ok, f"names cut inside a character, refused heads, {IDLE_SOCKETS} idle sockets, a ping flood, "
+                      f"SIGINT and stop during a 1e8-iteration step ({time.monotonic() - start:.1f} s)",
+            report + problems)
 
 
 def cmd_sanitize(argv):
