@@ -10,7 +10,7 @@ disconnects mid-drag (the server runs on), the refusals of a request without
 the token and of a foreign Origin, and the page's stop (exit 0, the summary
 with the new K). Beside it, on programs of their own: the stress of
 tools/cl/live_stress.py, the handouts' live sections, then the hostile
-client's cases (check_hostile)."""
+client's cases (tools/cl/live_hostile.py)."""
 import json
 import math
 import os
@@ -26,7 +26,8 @@ from pathlib import Path
 from .base import BIN, BUILD
 from .live import read_url
 from .live_handouts import check_handouts
-from .live_stress import FLOOD, IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile, check_stress
+from .live_hostile import IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile
+from .live_stress import FLOOD, check_stress
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
                   "--enable-unsafe-swiftshader", "--window-size=800,600", "--remote-debugging-port=0",

@@ -1,5 +1,5 @@
 """./course sanitize: the whole test suite under ASan and UBSan (build/asan), and its CI check;
-then lab 04's reference in live mode under the round-3 attacks (tools/cl/live_stress.py:
+then lab 04's reference in live mode under the round-3 attacks (tools/cl/live_hostile.py:
 check_hostile), whose server must stay clean too."""
 import argparse
 import atexit
@@ -143,7 +143,7 @@ def run_live(nice=False):
         import websocket  # noqa: F401  (Debian's python3-websocket, which the attacks' honest page uses)
     except ImportError:
         return name, True, "skipped: python3-websocket is not installed (./course installs it)", []
-    from .live_stress import IDLE_SOCKETS, check_hostile
+    from .live_hostile import IDLE_SOCKETS, check_hostile
     start = time.monotonic()
     program = SANITIZE_BUILD / "bin" / SANITIZE_LIVE
     with tempfile.TemporaryDirectory(prefix="cl-asan-live-") as work:
