@@ -17,7 +17,7 @@ import time
 import urllib.request
 from pathlib import Path
 
-from .live_stress import frame, open_socket, read_messages, rss
+from .live_stress import PAGE_SECONDS, frame, open_socket, read_messages, rss
 
 # Each case below is named by what it sends; each broke the server before the fix it checks.
 
