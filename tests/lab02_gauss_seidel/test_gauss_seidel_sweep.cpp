@@ -164,7 +164,7 @@ TEST_CASE("pinned particles never move", "[lab02][pts=1]") {
       if (scene == &chain) x.col(6) += Vector3d(0.5, 0.0, 0.0);
       const Matrix3Xd start = x;
       for (int sweep = 0; sweep < 30; ++sweep) gauss_seidel_sweep(x, scene->particles.inv_mass, scene->springs, order);
-      REQUIRE_FALSE(x.isApprox(start));
+      REQUIRE(cl::test::at_least("the largest move of a particle over 30 sweeps", (x - start).colwise().norm().maxCoeff(), 1e-9));
       for (Eigen::Index p = 0; p < x.cols(); ++p) {
         if (scene->particles.inv_mass[p] == 0.0) {
           REQUIRE(cl::test::near(x.col(p), start.col(p), 0.0, "pinned particle " + std::to_string(p)));

@@ -19,6 +19,7 @@
 #include "common/output.h"
 #include "common/scene.h"
 #include "simulation.h"
+#include "tests/support/checks.h"
 
 using cl::lab05::Limit;
 
@@ -80,7 +81,8 @@ TEST_CASE("a stiff chain held only by the spring limiter keeps the band, goes on
 
   // The same step without the limiter is stopped, and nothing is "exceeded" on top.
   const cl::lab05::RunResult unlimited = run(scene, Limit::kNone, 200, high, low);
-  CHECK_FALSE(unlimited.problem.empty());
+  CHECK(cl::test::answer("the unlimited run reports a problem", !unlimited.problem.empty(), true,
+                        "k dt^2/m up to 1e3 is far past the explicit limit"));
   CHECK(unlimited.steps_done < scene.steps);
   CHECK(unlimited.energy_exceeded_step == -1);
 }

@@ -10,6 +10,7 @@
 
 #include "common/scene.h"
 #include "simulation.h"
+#include "tests/support/checks.h"
 
 using cl::lab05::Limit;
 
@@ -88,7 +89,8 @@ TEST_CASE("the stiff curtain is reported unstable without a limiter and stays in
   cl::lab05::RunResult unlimited;
   const Extremes before = run(scene, Limit::kNone, 10, 300, unlimited);
   CAPTURE(unlimited.problem, unlimited.problem_step, before.steps);
-  REQUIRE(!unlimited.problem.empty());       // reported ...
+  REQUIRE(cl::test::answer("the unlimited run reports a problem", !unlimited.problem.empty(), true,
+                          "the explicit step is unstable at k dt^2/m = 1.0"));  // reported ...
   REQUIRE(unlimited.problem_step > 0);
   REQUIRE(unlimited.problem_step < 300);
   REQUIRE(before.finite);                    // ... and every step before it was finite: no silent NaN
@@ -103,4 +105,21 @@ TEST_CASE("the stiff curtain is reported unstable without a limiter and stays in
   REQUIRE(after.min >= -0.1 - 0.05);
   // The limiter is busy: the springs sit at the edges of the band.
   REQUIRE(after.max >= 0.1 - 1e-6);
+}
+
+TEST_CASE("a spring-limited soft curtain never gains energy", "[lab05][pts=1]") {
+  // The soft curtain's explicit step is stable (k dt²/m = 0.1), and a correct
+  // limiter only takes motion out: each projection is the mass-weighted
+  // closest length in the band, so it keeps the centre of mass, and the
+  // velocity update removes the stretching velocity it undid. A limiter that
+  // holds the band but moves the springs' ends any other way pushes the
+  // cloth around and puts energy in, while nothing else in the run looks
+  // wrong: its strains are in the band and it reports no problem.
+  const cl::Scene scene = shipped("soft-curtain-32");
+  cl::lab05::RunResult result;
+  run(scene, Limit::kSprings, 10, 300, result);
+  CAPTURE(result.energy_start, result.energy_end, result.energy_scale);
+  REQUIRE(cl::test::healthy(result));
+  REQUIRE(cl::test::at_most("the largest rise of the total energy above its start (J)", result.max_energy_rise,
+                            1e-3 * result.energy_scale));
 }
