@@ -238,6 +238,7 @@ class Collector : public benchmark::ConsoleReporter {
       if (springs != run.counters.end()) entry.springs = springs->second.value;
     }
   }
+  bool empty() const { return entries_.empty(); }
   // ns per spring of the benchmark `name`, 0 when it did not run.
   double per_spring(const std::string& name) const {
     const auto found = entries_.find(name);
@@ -257,6 +258,7 @@ class Collector : public benchmark::ConsoleReporter {
 };
 
 void summary(const Collector& runs) {
+  if (runs.empty()) return;  // --benchmark_list_tests, or a filter that matched nothing
   std::printf("\nsweep cost, ns per spring (CPU time, median):\n");
   std::printf("  %-7s %9s %9s %9s %9s %9s %9s %9s\n", "cloth", "GS", "GS-call", "GS-colour", "Jacobi", "Jac-call",
               "XPBD", "XPBD-call");
@@ -269,8 +271,9 @@ void summary(const Collector& runs) {
     const double jacobi_call = runs.per_spring("BM_JacobiSweepCalling" + arg);
     const double xpbd = runs.per_spring("BM_XpbdStep" + arg);
     const double xpbd_call = runs.per_spring("BM_XpbdStepCalling" + arg);
-    std::printf("  %3d²    %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f\n", n, gs, gs_call, gs_colour, jacobi,
-                jacobi_call, xpbd, xpbd_call);
+    if (gs + gs_call + gs_colour + jacobi + jacobi_call + xpbd + xpbd_call == 0.0) continue;  // none ran
+    std::printf("  %3d²    %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f   (0: not run)\n", n, gs, gs_call, gs_colour,
+                jacobi, jacobi_call, xpbd, xpbd_call);
     auto ratio = [&](const char* what, double a, double b) {
       if (a > 0.0 && b > 0.0) std::printf("ratio %s at %d²: %.2f\n", what, n, a / b);
     };
