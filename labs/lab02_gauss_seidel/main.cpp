@@ -2,11 +2,13 @@
 // order, with the strain error and the change in positions after every sweep.
 // With --compare ORDER: the same sweeps from the same start in a second order,
 // and how far apart the two final states are.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "common/cli.h"
 #include "common/driver.h"
@@ -28,6 +30,17 @@ struct LabOptions {
   long long seed = 1;
   double tolerance = 1e-10;
 };
+
+// The median wall time of one sweep in the log (NaN when it has none).
+double median_sweep_seconds(const cl::lab02::ConvergenceLog& log) {
+  std::vector<double> seconds;
+  for (const cl::lab02::SweepRecord& record : log.records()) {
+    if (record.sweep > 0) seconds.push_back(record.sweep_seconds);
+  }
+  if (seconds.empty()) return std::numeric_limits<double>::quiet_NaN();
+  std::nth_element(seconds.begin(), seconds.begin() + static_cast<std::ptrdiff_t>(seconds.size() / 2), seconds.end());
+  return seconds[seconds.size() / 2];
+}
 
 // K sweeps in `order` from `start`; returns the log, leaves the final state in x
 // and keeps the state after every due sweep in `trajectory` (when given).
@@ -111,6 +124,12 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
                 " (%s)\n",
                 lab.order.c_str(), lab.compare.c_str(), options.iterations, difference, log.last().max_strain_error,
                 other_log.last().max_strain_error, cl::lab02::outcome_name(other_log.outcome()));
+    // The same projections in another order: what the order alone does to the
+    // time (the median sweep of each run, robust to another job's turn).
+    const double ratio = median_sweep_seconds(other_log) / median_sweep_seconds(log);
+    if (std::isfinite(ratio) && ratio > 0.0) {
+      std::printf("  median sweep time, %s / %s: %.2f\n", lab.compare.c_str(), lab.order.c_str(), ratio);
+    }
     compare_json["order"] = lab.compare;
     compare_json["max_position_difference"] = difference;
     compare_json["max_strain_error"] = other_log.last().max_strain_error;

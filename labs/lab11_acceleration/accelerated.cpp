@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -356,7 +355,9 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
     }
     return trial;
   };
-  std::deque<CurvaturePair> history;
+  // The pairs, oldest first, handed to lbfgs_direction as they are (no copy
+  // per iteration): dropping the oldest moves the others' vectors, not their values.
+  std::vector<CurvaturePair> history;
   double g = lab06::objective(problem, x, y);
   Eigen::VectorXd gradient = lab06::newton_gradient(problem, x, y);
   bool stopped = record(0, g);
@@ -365,8 +366,7 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
       report.problem = "pd-lbfgs iteration " + std::to_string(k) + ": the gradient is not finite";
       break;
     }
-    const std::vector<CurvaturePair> pairs(history.begin(), history.end());
-    Eigen::VectorXd direction = lbfgs_direction(gradient, pairs, initial);
+    Eigen::VectorXd direction = lbfgs_direction(gradient, history, initial);
     double slope = gradient.dot(direction);
     if (!(slope < 0.0) || !direction.allFinite()) {  // not a descent: forget the history, take PD's direction
       history.clear();
@@ -425,7 +425,7 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
     }
     if (settings.history > 0) {
       history.push_back({alpha * direction, next_gradient - gradient});
-      if (static_cast<int>(history.size()) > settings.history) history.pop_front();
+      if (static_cast<int>(history.size()) > settings.history) history.erase(history.begin());
     }
     x = trial;
     gradient = next_gradient;

@@ -167,7 +167,7 @@ class Solver {
   std::vector<Spring> springs_;
   double dt_;
   std::optional<lab06::Problem> problem_;
-  SpdFactorization factor_;
+  SpdFactorization factor_{SpdBackend::kSimplicial};  // A, kept for the whole scene (one-pass solve3), as lab 06
   std::unique_ptr<lab06::Solver> newton_;
   std::optional<lab04::ConstraintSet> constraints_;
   double factor_seconds_ = 0.0;

@@ -14,6 +14,24 @@ void require_finite_non_negative(double value, const char* name) {
                                 std::to_string(value) + ")");
   }
 }
+
+// The formula alone, without the argument checks: project_distance_xpbd is
+// its checks and this; xpbd_step checks every argument once per step, before
+// its sweeps, and calls this inline, so that no projection pays for them.
+inline XpbdCorrection xpbd_correction(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double inv_mass_i,
+                                      double inv_mass_j, double rest_length, double alpha_tilde, double lambda) {
+  XpbdCorrection correction;
+  const Eigen::Vector3d d = x_i - x_j;
+  const double length = d.norm();
+  const double denominator = inv_mass_i + inv_mass_j + alpha_tilde;
+  if (length == 0.0 || denominator == 0.0) return correction;
+  const Eigen::Vector3d n = d / length;
+  correction.dlambda = (-(length - rest_length) - alpha_tilde * lambda) / denominator;
+  correction.dx_i = (inv_mass_i * correction.dlambda) * n;
+  correction.dx_j = (-inv_mass_j * correction.dlambda) * n;
+  return correction;
+}
+
 }  // namespace
 
 XpbdCorrection project_distance_xpbd(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double inv_mass_i,
@@ -25,16 +43,7 @@ XpbdCorrection project_distance_xpbd(const Eigen::Vector3d& x_i, const Eigen::Ve
   if (!std::isfinite(lambda)) {
     throw std::invalid_argument("project_distance_xpbd: lambda must be finite (got " + std::to_string(lambda) + ")");
   }
-  XpbdCorrection correction;
-  const Eigen::Vector3d d = x_i - x_j;
-  const double length = d.norm();
-  const double denominator = inv_mass_i + inv_mass_j + alpha_tilde;
-  if (length == 0.0 || denominator == 0.0) return correction;
-  const Eigen::Vector3d n = d / length;
-  correction.dlambda = (-(length - rest_length) - alpha_tilde * lambda) / denominator;
-  correction.dx_i = (inv_mass_i * correction.dlambda) * n;
-  correction.dx_j = (-inv_mass_j * correction.dlambda) * n;
-  return correction;
+  return xpbd_correction(x_i, x_j, inv_mass_i, inv_mass_j, rest_length, alpha_tilde, lambda);
 }
 
 void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, const XpbdSettings& settings,
@@ -93,11 +102,13 @@ void xpbd_step(Particles& particles, const lab04::ConstraintSet& constraints, co
   }
 
   // λ belongs to the step: it starts from 0 here and accumulates over all K sweeps.
+  // Everything project_distance_xpbd checks was checked above, once: the
+  // sweeps call its formula directly.
   lambda.setZero(spring_count);
   for (int k = 0; k < settings.iterations; ++k) {
     for (const int s : constraints.order) {
       const Spring& spring = springs[static_cast<std::size_t>(s)];
-      const XpbdCorrection correction = project_distance_xpbd(
+      const XpbdCorrection correction = xpbd_correction(
           predicted.col(spring.i), predicted.col(spring.j), particles.inv_mass[spring.i],
           particles.inv_mass[spring.j], spring.rest_length, alpha_tilde[static_cast<std::size_t>(s)], lambda[s]);
       predicted.col(spring.i) += correction.dx_i;
