@@ -49,8 +49,14 @@ const std::vector<MethodInfo>& all_methods();
 const std::vector<MethodInfo>& contact_methods();
 // Whether the method steps against the scene's colliders (one of contact_methods()).
 bool models_colliders(const MethodInfo& method);
-// Either list's method; throws std::invalid_argument for an unknown name (the message lists them).
+// Either list's method; throws std::invalid_argument for an unknown name (the
+// message lists them), and for a contact-* name in a build without lab 14's
+// reference (the message says so, with kNoContactMethods).
 const MethodInfo& method_info(const std::string& name);
+// Why a build has no contact methods: lab 14's reference ships after its
+// deadline (a student tree of week 14 has the earlier labs' only).
+inline constexpr const char* kNoContactMethods =
+    "solutions/lab14_contact/ ships after lab 14's deadline; the instructor's tree has it";
 
 struct StepOutcome {
   std::string problem;  // non-empty: the lab's step said it could not be done

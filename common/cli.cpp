@@ -67,6 +67,9 @@ CLI::Validator finite_in(double low, double high) {
 }
 
 namespace {
+// The name of integer_in's validators, by which Option::range finds one to replace.
+constexpr const char* kIntegerRange = "integer range";
+
 // A whole argument read as an integer in [low, high]; `name` is what --help shows.
 CLI::Validator integer_check(long long low, long long high, const std::string& name) {
   return CLI::Validator(
@@ -93,7 +96,9 @@ CLI::Validator any_integer(long long low, long long high) { return integer_check
 }  // namespace
 
 CLI::Validator integer_in(long long low, long long high) {
-  return integer_check(low, high, "[" + std::to_string(low) + ", " + std::to_string(high) + "]");
+  CLI::Validator check = integer_check(low, high, "[" + std::to_string(low) + ", " + std::to_string(high) + "]");
+  check.name(kIntegerRange).non_modifying();
+  return check;
 }
 
 CommonOptions lab_defaults(std::string scene, std::string method, std::vector<std::string> methods) {
@@ -146,7 +151,18 @@ void add_common_options(CLI::App& app, CommonOptions& options, unsigned flags) {
 }
 
 Option& Option::range(long long low, long long high) {
-  option_->check(integer_in(low, high));
+  // A range given to a common flag (--iterations' [0, 1e8]) replaces it, so
+  // that the refusal and --help state the range that holds.
+  CLI::Validator* existing = nullptr;
+  try {
+    existing = option_->get_validator(kIntegerRange);
+  } catch (const CLI::OptionNotFound&) {
+  }
+  if (existing != nullptr) {
+    *existing = integer_in(low, high);
+  } else {
+    option_->check(integer_in(low, high));
+  }
   return *this;
 }
 

@@ -111,7 +111,9 @@ class CommandLine;
 class Option {
  public:
   explicit Option(CLI::Option* option, CommandLine* line = nullptr) : option_(option), line_(line) {}
-  Option& range(long long low, long long high);                // an integer in [low, high] (integer_in)
+  // An integer in [low, high] (integer_in); on a common flag that has a range
+  // already (--iterations), it replaces it.
+  Option& range(long long low, long long high);
   Option& one_of(const std::vector<std::string>& words);       // one of these words (CLI::IsMember)
   Option& positive();                                          // finite_number(false): finite, > 0
   Option& non_negative();                                      // finite_number(true): finite, >= 0

@@ -24,8 +24,9 @@ ContactProjection project_contact(const Eigen::Vector3d& p, double inv_mass, con
   not_implemented("project_contact", __FILE__);
 }
 
-// TODO(lab14.3) [6 pts] Δx_t = (I − n nᵀ)(p − x); undo it inside the cone
-// (‖Δx_t‖ <= μ d: stuck, also when Δx_t = 0), shorten it by μ d outside. Graded by
+// TODO(lab14.3) [7 pts] Δx_t = (I − n nᵀ)(p − x); undo it inside the cone
+// (‖Δx_t‖ <= μ d: stuck, also when Δx_t = 0, μ = 0 included), shorten it by μ d
+// outside; nothing, and not stuck, when d = 0 or w = 0. Graded by
 // tests/lab14_contact/test_friction.cpp and test_incline.cpp.
 Eigen::Vector3d friction_correction(const Eigen::Vector3d& x, const Eigen::Vector3d& p, double inv_mass,
                                     const Eigen::Vector3d& normal, double depth, double friction, bool& stuck) {

@@ -87,8 +87,9 @@ ContactProjection project_contact(const Eigen::Vector3d& p, double inv_mass, con
 // d = 0 or Δx_t = 0. The correction is tangential: n·correction = 0 (to
 // round-off), so the contact stays met. `stuck` is set to whether the static
 // case applied: w > 0, d > 0 and ‖Δx_t‖ <= μ d (true too for a particle
-// pressed onto the surface with no tangential move, Δx_t = 0), false
-// otherwise. The driver counts sticking and sliding contacts by it.
+// pressed onto the surface with no tangential move, Δx_t = 0, whatever μ:
+// with μ = 0, 0 <= 0), false otherwise (d = 0: nothing presses, so nothing
+// sticks). The driver counts sticking and sliding contacts by it.
 // Throws std::invalid_argument for a non-finite x, p or normal, a normal not of
 // length 1 (as project_contact), a negative or non-finite inverse mass, depth
 // or friction.

@@ -16,8 +16,10 @@ struct LabOptions {
   std::optional<double> friction;                 // --friction: μ for every collider
   bool drape = false;                             // experiment 1
   bool incline = false;                           // experiment 2
-  std::vector<double> frictions;                  // --frictions (empty: kFrictions)
-  std::vector<double> angles;                     // --angles, degrees (empty: kAngles)
+  std::vector<std::string> frictions_given;       // --frictions as given: "0,0.3,1" (check_lab_options reads it)
+  std::vector<std::string> angles_given;          // --angles as given
+  std::vector<double> frictions;                  // --frictions read (empty: kFrictions)
+  std::vector<double> angles;                     // --angles read, degrees (empty: kAngles)
 };
 
 // The driver's default --scene.
@@ -31,14 +33,25 @@ inline const std::vector<double> kAngles{5, 10, 15, 16, 16.5, 16.9, 17, 20, 30, 
 // The largest μ a flag takes (--friction, --frictions).
 inline constexpr double kMaxFriction = 1e6;
 
-// Throws InputError for --frictions or --angles given without an experiment,
-// or a friction that is not a finite number in [0, kMaxFriction].
-void check_lab_options(const LabOptions& lab);
+// Reads --frictions and --angles into `frictions` and `angles`. Throws
+// InputError for either given without its experiment, an entry that is empty
+// ("", "0.3,,1": refused, never read as 0 or skipped) or not a finite number,
+// or a friction outside [0, kMaxFriction].
+void check_lab_options(LabOptions& lab);
 
 // One stderr line for a scene whose particles start inside colliders: how
 // many, the deepest and which particle, and that they were moved out to the
 // surface before frame 0 (no kinetic energy given to them).
 void report_initial_penetration(const char* lab_name, const InitialPenetration& initial);
+
+// The centre of mass of the movable particles (pinned ones have no mass to
+// weigh), m; the origin when none moves.
+Eigen::Vector3d centre_of_mass(const Particles& particles);
+
+// How far a point moved sideways, across gravity, from `start` to `end` (m;
+// the whole move when there is no gravity). For the centre of mass of a
+// mirror-symmetric scene it is 0 while a run keeps the symmetry.
+double sideways_drift(const Eigen::Vector3d& start, const Eigen::Vector3d& end, const Eigen::Vector3d& gravity);
 
 // The step settings of a run: --method, --iterations, the scene's dt and
 // gravity, --friction.
@@ -54,7 +67,8 @@ Scene incline_scene(double degrees, double friction, int steps);
 // kinetic + potential energy, the time per step, and the time to rest (the
 // first step from which the kinetic energy per kilogram stays below 1e-4
 // J/kg to the end; empty when it never does) and the particle-steps the
-// last resort moved back (StepReport::moved_back) -> OUT/drape.csv, a table.
+// last resort moved back (StepReport::moved_back), and how far the centre of
+// mass moved sideways (sideways_drift) -> OUT/drape.csv, a table.
 int run_drape(const char* lab_name, const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab);
 
 // Experiment 2: for each method, each μ of --frictions and each θ of

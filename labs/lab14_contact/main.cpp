@@ -62,6 +62,7 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
       cl::frame_output(options, kLab, scene, "per_step.csv", cl::lab14::step_columns(), options.method);
   output.index_column = "step";
   cl::Particles& particles = scene.particles;
+  const Eigen::Vector3d centre_start = cl::lab14::centre_of_mass(particles);
   const cl::lab14::RunResult result =
       cl::lab14::run_steps(particles, stepper, scene.springs, scene.colliders, scene.steps, nullptr, output);
   const cl::StrainStats strain = cl::strain_stats(particles.x, scene.springs);
@@ -105,6 +106,8 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
     summary.extra["initial_penetration"] = initial.deepest;        // m, before the load moved them out
     summary.extra["initial_penetration_particles"] = initial.particles;
     summary.extra["max_normal_force"] = result.max_normal_force;
+    summary.extra["centre_of_mass_drift"] =  // m, sideways: 0 while a mirror-symmetric run stays symmetric
+        cl::lab14::sideways_drift(centre_start, cl::lab14::centre_of_mass(particles), scene.gravity);
     cl::add_energies(summary, cl::kinetic_energy(particles), cl::potential_energy(particles, scene.gravity),
                      std::nullopt, result.energy_start);
     cl::add_stop_outcome(summary, result.problem.empty() ? "" : (result.step_failed ? result.problem : "diverged: " + result.problem),
@@ -126,7 +129,8 @@ int main(int argc, char** argv) {
   options.models_colliders = true;
   cl::add_common_options(app, options, cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagDt |
                                            cl::kFlagSteps | cl::kFlagOut | cl::kFlagSummary | cl::kFlagFrames);
-  app.get_option("--iterations").range(1, 100000);
+  app.get_option("--iterations").range(1, 100000).description("pbd/xpbd: sweeps and contact passes; constrained: "
+                                                               "block iterations (1 to 100000)");
   LabOptions lab;
   cl::add_live_option(app, live);
   // μ above kMaxFriction sticks every contact as firmly as any larger one
@@ -138,10 +142,10 @@ int main(int argc, char** argv) {
       .excludes(method);
   app.add_flag("--incline", lab.incline, "experiment 2: the stick/slip boundary against mu per method -> incline.csv")
       .excludes(method);
-  app.add_option("--frictions", lab.frictions, "--drape, --incline: the friction coefficients (default 0,0.3,1)")
-      .delimiter(',');
-  app.add_option("--angles", lab.angles, "--incline: the incline's angles, degrees in (0, 90) (default: 16 around "
-                                         "atan 0.3 and atan 1)").delimiter(',');
+  // The lists are read whole (check_lab_options): an empty entry is refused, not skipped.
+  app.add_option("--frictions", lab.frictions_given, "--drape, --incline: the friction coefficients (default 0,0.3,1)");
+  app.add_option("--angles", lab.angles_given, "--incline: the incline's angles, degrees in (0, 90) (default: 16 "
+                                               "around atan 0.3 and atan 1)");
   return cl::run_main(app, argc, argv, [&] {
     cl::set_blas_threads(1);  // CHOLMOD's BLAS: small solves, and idle OpenBLAS threads spin (lab 13)
     cl::lab14::check_lab_options(lab);

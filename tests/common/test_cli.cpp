@@ -123,6 +123,28 @@ TEST_CASE("a flag the chosen method does not use is refused in one line", "[comm
   CHECK(run_line({"--seed", "12"}).first == 0);
 }
 
+TEST_CASE("a range given to a common integer flag replaces the common one", "[common][cli]") {
+  // Lab 14 takes --iterations in [1, 100000]: its refusal and --help must
+  // state that range, not the common flag's [0, 100000000] checked first.
+  for (const char* given : {"0", "6", "-3"}) {
+    CAPTURE(given);
+    cl::CommandLine line{"test", "probe"};
+    cl::CommonOptions options = cl::lab_defaults("two-particles", "pd", {"pd"});
+    cl::add_common_options(line, options, cl::kFlagIterations);
+    line.get_option("--iterations").range(1, 5);
+    CHECK_THAT(line.app().help(), Contains("[1, 5]") && !Contains("100000000"));
+    std::vector<std::string> arguments{"probe", "--iterations", given};
+    std::vector<char*> argv;
+    for (std::string& argument : arguments) argv.push_back(argument.data());
+    std::ostringstream captured;
+    std::streambuf* const saved = std::cerr.rdbuf(captured.rdbuf());
+    const int code = cl::run_main(line, static_cast<int>(argv.size()), argv.data(), [] { return 0; });
+    std::cerr.rdbuf(saved);
+    CHECK(code == 2);
+    CHECK(captured.str() == "probe: --iterations: " + std::string(given) + " is not in [1, 5] (see --help)\n");
+  }
+}
+
 namespace {
 // A CommandLine with a mode (--convergence, which alone reads --warmup) and a
 // run-only --steps; the exit code, stdout and stderr of one call, whose body

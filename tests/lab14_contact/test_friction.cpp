@@ -70,16 +70,39 @@ TEST_CASE("friction's bound mu d is a length: the same for every mass", "[lab14]
 }
 
 TEST_CASE("a particle pressed onto the surface with no tangential move is stuck", "[lab14][pts=1]") {
-  // Δx_t = 0 <= μ d: the static case, with nothing to undo. The driver's
-  // sticking and sliding counts come from `stuck`.
+  // Δx_t = 0 <= μ d: the static case, with nothing to undo, for every μ: with
+  // μ = 0 the bound μ d is 0 too, and 0 <= 0 (a strict test would take the
+  // kinetic branch and divide 0 by 0). The driver's sticking and sliding
+  // counts come from `stuck`.
   const Eigen::Vector3d normal(0.0, 1.0, 0.0);  // the tangential part of a move along it is exactly 0
   const Eigen::Vector3d x(0.2, 0.1, -0.3);
-  for (const double mu : {0.3, 1.0}) {
+  for (const double mu : {0.0, 0.3, 1.0}) {
     CAPTURE(mu);
     bool stuck = false;
     const Eigen::Vector3d correction =
         cl::lab14::friction_correction(x, x - 0.004 * normal, 1.0, normal, 0.004, mu, stuck);
     CHECK(cl::test::near(correction, Eigen::Vector3d::Zero(), 0.0, "correction"));
     CHECK(cl::test::answer("friction_correction(Δx_t = 0, d > 0) stuck", stuck, true, "0 <= μ d"));
+  }
+}
+
+TEST_CASE("a particle not pressed onto the surface is never stuck", "[lab14][pts=1]") {
+  // d = 0: no normal correction, so no normal force and no static friction,
+  // even when nothing moves along the surface (Δx_t = 0 <= μ d = 0 would
+  // otherwise count it as stuck). The same for a pinned particle (w = 0).
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.0, 3.0, 4.0) / 5.0;
+  const Eigen::Vector3d x(0.2, 0.1, -0.3);
+  for (const double mu : {0.0, 0.3, 1.0}) {
+    for (const double along_normal : {0.0, 0.01}) {
+      CAPTURE(mu, along_normal);
+      bool stuck = true;
+      const Eigen::Vector3d correction =
+          cl::lab14::friction_correction(x, x + along_normal * normal, 1.0, normal, 0.0, mu, stuck);
+      CHECK(cl::test::near(correction, Eigen::Vector3d::Zero(), 0.0, "correction"));
+      CHECK(cl::test::answer("friction_correction(Δx_t = 0, d = 0) stuck", stuck, false, "d = 0: nothing presses"));
+      stuck = true;
+      cl::lab14::friction_correction(x, x - along_normal * normal, 0.0, normal, 0.004, mu, stuck);
+      CHECK(cl::test::answer("friction_correction(Δx_t = 0, w = 0) stuck", stuck, false, "a pinned particle"));
+    }
   }
 }

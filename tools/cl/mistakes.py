@@ -258,6 +258,16 @@ def cmd_mistakes(argv):
                         help="also run every other graded case, and name those a mistake fails too")
     args = parser.parse_args(argv)
     labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
+    # A catalogue ships with its lab's reference, after the deadline: in a
+    # student tree the current week's is the instructor's (as ./course bench).
+    absent = [lab for lab in labs if not (ROOT / "solutions" / lab).is_dir()]
+    if absent:
+        message = (f"./course mistakes {grade.lab_id(absent[0])} is the instructor's: its catalogue, "
+                   f"solutions/{absent[0]}/mistakes.json, comes with the lab's reference after its deadline"
+                   f"{' (and so for ' + ', '.join(grade.lab_id(lab) for lab in absent[1:]) + ')' if absent[1:] else ''}")
+        if args.labs:
+            raise CourseError(message, code=2)
+        print(message)
     failed = 0
     for lab, (caught, planted, lines) in run_mistakes(labs, every_case=args.all_cases).items():
         print(f"mistakes {lab}: {caught}/{planted} caught")
