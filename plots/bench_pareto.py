@@ -59,31 +59,29 @@ def main(out_dir):
     if rows and "relative_residual" in rows[0]:
         measures.append(("relative_residual", "step residual Δt²‖∇g‖_M⁻¹\n/ the start's", residual_levels))
     measures.append(("relative_distance", "distance to reference step\n/ step displacement", distance_levels))
-    figure = plt.figure(figsize=(3.9 * len(scenes), 3.6 * len(measures) * len(starts) + 1.5))
-    panels = figure.subfigures(len(starts), 1, squeeze=False)[:, 0] if len(starts) > 1 else [figure]
+    panel_height = 3.6 * len(measures)
+    figure = plt.figure(figsize=(3.9 * len(scenes), panel_height * len(starts) + 1.8))
+    # One subfigure per start, and one for the legend below them.
+    parts = figure.subfigures(len(starts) + 1, 1, squeeze=False,
+                              height_ratios=[panel_height] * len(starts) + [1.8])[:, 0]
     all_axes = []
-    for start, panel in zip(starts, panels):
+    for start, panel in zip(starts, parts):
         axes = panel.subplots(len(measures), len(scenes), squeeze=False)
         all_axes.append(axes)
-        panel.suptitle(f"from the {start} start" + (" (10 accurate steps from rest)" if start == "trajectory"
-                                                    else " (10 steps of PD, 100 iterations: compressed and folded)"),
+        panel.suptitle(f"From the {start} start" + (" (10 accurate steps from rest)" if start == "trajectory"
+                                                    else " (10 steps of PD, 100 iterations: compressed and folded)")
+                       + "\nerror against time per step, K growing along each line (circles: the Pareto front)",
                        fontsize=11)
         draw_panel(axes, [r for r in rows if r["start"] == start], scenes, methods, colors, measures,
                    {(key, scene): value for (key, scene, s), value in spread.items() if s == start})
-    handles, labels = all_axes[0][0][-1].get_legend_handles_labels()
+    handles, labels = [], []
     for axes in all_axes:
         for ax in axes.flat:
             for h, lab in zip(*ax.get_legend_handles_labels()):
                 if lab not in labels:
                     handles.append(h)
                     labels.append(lab)
-    figure.legend(handles, labels, loc="lower center", ncol=min(len(labels), 5), fontsize=8)
-    figure.suptitle("Error against time per step: one step from each start, K growing along each line "
-                    "(circles: the Pareto front)", fontsize=12)
-    if len(starts) == 1:
-        figure.tight_layout(rect=(0, 1.5 / figure.get_figheight(), 1, 0.96))
-    else:
-        figure.subplots_adjust(bottom=1.5 / figure.get_figheight())
+    parts[-1].legend(handles, labels, loc="center", ncol=min(len(labels), 5), fontsize=8)
     figures.save(figure, target, dpi=80)
     return 0
 
