@@ -37,6 +37,7 @@ MEASURES = {  # trade_fastest.csv's measure: (its name in a table header, its ta
     "relative_residual_hard": ("hard residual", (1e-3, 1e-6)),
 }
 NEWTONS = ("newton", "constrained-newton", "constrained-newton-drop")
+STARTS = ("trajectory", "rough")  # trade's --start, in the order the tables give them
 
 
 # ---------------------------------------------------------------- reading
@@ -114,13 +115,25 @@ def scene_order(name):
     return (1, int(match.group(1))) if match else (0 if name.startswith("rope") else 2, 0)
 
 
+def start_of(row):
+    """A row's start; runs before the column existed were all from the rough start."""
+    return row.get("start") or "rough"
+
+
+def label(scene, start):
+    """curtain-32 from the trajectory start; "curtain-32 (rough)" from the rough one."""
+    return scene if start == "trajectory" else f"{scene} (rough)"
+
+
 # ---------------------------------------------------------------- the run
 
 class Run:
     def __init__(self, folder):
         self.folder = folder
         self.runs = read(folder / "trade.csv")
-        self.scenes = sorted(read(folder / "trade_scenes.csv"), key=lambda s: scene_order(s["scene"]))
+        self.scenes = sorted(read(folder / "trade_scenes.csv"),
+                             key=lambda s: (STARTS.index(start_of(s)), scene_order(s["scene"])))
+        self.starts = [start for start in STARTS if any(start_of(s) == start for s in self.scenes)]
         self.fastest = read(folder / "trade_fastest.csv")
         self.scaling = read(folder / "trade_scaling.csv")
         contact = folder / "trade_contact.csv"
@@ -134,35 +147,49 @@ class Run:
         k = "" if self.family.get(method) == "linearized" else f" K={iterations}"
         return f"{method}{k}, {duration(seconds)}"
 
-    def fastest_cell(self, scene, measure, target):
+    def fastest_cell(self, scene, start, measure, target):
         for r in self.fastest:
-            if r["scene"] == scene and r["measure"] == measure and math.isclose(number(r["target"]), target):
+            if (r["scene"] == scene and start_of(r) == start and r["measure"] == measure
+                    and math.isclose(number(r["target"]), target)):
                 if r["method"] == "unresolved":
                     return f"unresolved (spread {sci(number(r['value']))})"
                 if r["method"] == "none":
-                    return "none reached"
+                    mine = [x for x in self.good(scene, start=start) if math.isfinite(number(x[measure]))]
+                    if not mine:
+                        return "none reached"
+                    best = min(mine, key=lambda x: number(x[measure]))
+                    return f"none reached (best {sci(number(best[measure]))}: {best['method']} K={best['iterations']})"
                 return self.cell(r["method"], r["iterations"], number(r["step_seconds"]))
         return "—"
 
-    def fastest_table(self, measures):
+    def fastest_table(self, measures, starts=None):
         header = ["scene"] + [f"{MEASURES[m][0]} ≤ {power(t)}" for m in measures for t in MEASURES[m][1]]
-        rows = [[s["scene"]] + [self.fastest_cell(s["scene"], m, t) for m in measures for t in MEASURES[m][1]]
-                for s in self.scenes]
+        rows = [[label(s["scene"], start_of(s))] + [self.fastest_cell(s["scene"], start_of(s), m, t)
+                                                    for m in measures for t in MEASURES[m][1]]
+                for s in self.scenes if starts is None or start_of(s) in starts]
         return table(header, rows)
 
-    def good(self, scene=None, method=None):
+    def good(self, scene=None, method=None, start=None):
         return [r for r in self.runs if not r["problem"] and (scene is None or r["scene"] == scene)
-                and (method is None or r["method"] == method)]
+                and (method is None or r["method"] == method) and (start is None or start_of(r) == start)]
+
+    def caps(self):
+        """The step cap of each scene, as a caption says it."""
+        caps = dict.fromkeys((s["scene"], number(s.get("step_cap"))) for s in self.scenes)
+        if not caps or not all(math.isfinite(c) for _, c in caps):
+            return "the step cap: see the settings"
+        return "step cap " + ", ".join(f"{scene} {duration(cap)}" for scene, cap in caps)
 
     def header(self, machine):
         seconds = self.log["seconds"]
         start = self.ended - datetime.timedelta(seconds=seconds) if seconds else None
         when = (f"{start:%Y-%m-%d %H:%M}–{self.ended:%H:%M} UTC" if start else f"ended {self.ended:%Y-%m-%d %H:%M} UTC")
         length = f"{seconds} s ({seconds / 60:.0f} min)" if seconds else "length not recorded (no trade.log)"
-        scenes = ", ".join(s["scene"] for s in self.scenes) + (", " + ", ".join(
+        scenes = ", ".join(dict.fromkeys(s["scene"] for s in self.scenes)) + (", " + ", ".join(
             dict.fromkeys(r["scene"] for r in self.contact)) if self.contact else "")
         lines = [f"**The run**: {when}, `build/bin/trade --out {self.folder}`, {length}; "
-                 f"{len(self.runs)} runs of {len(self.family)} methods on {scenes}"
+                 f"{len(self.runs)} runs of {len(self.family)} methods on {scenes}, from "
+                 + " and ".join(f"the {start} start" for start in self.starts)
                  + (f" (and {len(self.contact)} contact runs)" if self.contact else "") + "."]
         if self.log["settings"]:
             lines.append(f"Settings: {self.log['settings']}.")
@@ -188,7 +215,11 @@ def reference_tables(run):
         second = (f"{s['second_route_iterations']} it., spread {sci(spread)}" if math.isfinite(spread) else
                   f"not converged (‖∇g‖∞ {sci(g(s['second_route_gradient_norm']))} N after "
                   f"{s['second_route_iterations']})")
-        k_rows.append([s["scene"], f"{s['particles']} / {s['springs']}", sci(g(s["step_displacement_rms"])),
+        made = (f"lab 13, {s['start_constrained_newton_iterations']} it." +
+                (f" + {s['start_newton_iterations']}" if int(s.get("start_newton_iterations") or 0) else "")
+                + f", {duration(g(s['start_seconds']))}" if start_of(s) == "trajectory" else "PD")
+        k_rows.append([label(s["scene"], start_of(s)), f"{s['particles']} / {s['springs']}", made,
+                       sci(g(s["step_displacement_rms"])),
                        f"{s['reference_constrained_newton_iterations']} → {sci(g(s['reference_constrained_gradient_norm']))}",
                        f"{s['reference_newton_iterations']} → {sci(g(s['reference_gradient_norm']))}",
                        duration(g(s["reference_seconds"])), second, sci(g(s["start_residual"])),
@@ -200,15 +231,16 @@ def reference_tables(run):
                       if math.isfinite(hard_spread) else
                       f"not converged (‖∇g‖∞ {sci(g(s['hard_second_route_gradient_norm']))} N after "
                       f"{s['hard_second_route_iterations']})")
-            hard_rows.append([s["scene"], f"{s['hard_iterations']} (force error {sci(g(s['hard_force_error']))})",
+            hard_rows.append([label(s["scene"], start_of(s)), f"{s['hard_iterations']} (force error {sci(g(s['hard_force_error']))})",
                               s["hard_newton_iterations"], sci(g(s["hard_gradient_norm"])), duration(g(s["hard_seconds"])),
                               sci(moved), second, sci(g(s["hard_relative_residual_hard"]))])
         else:
-            hard_rows.append([s["scene"], "not computed", "", "", "", "", "", ""])
-    lines = ["The k step (the reference): lab 13's iterations and then the polish's, each to its ‖∇g‖∞ (N); "
+            hard_rows.append([label(s["scene"], start_of(s)), "not computed", "", "", "", "", "", ""])
+    lines = ["The start (the trajectory start: lab 13's iterations over its steps, + the polish's, and its time) "
+             "and the k step from it (the reference): lab 13's iterations and then the polish's, each to its ‖∇g‖∞ (N); "
              "the second route (the polish from the start alone) and its spread; the start's residual (m), "
              "the reference's own residual over it, and g(start) − g(reference) (J):", ""]
-    lines += table(["scene", "particles / springs", "step's move, RMS (m)", "lab 13 → ‖∇g‖∞", "polish → ‖∇g‖∞",
+    lines += table(["scene", "particles / springs", "start", "step's move, RMS (m)", "lab 13 → ‖∇g‖∞", "polish → ‖∇g‖∞",
                     "time", "second route", "start residual", "reference's relative residual", "g drop (J)"], k_rows)
     lines += ["", "The hard step (k = 1e9 N/m): lab 13's iterations (its force error), the polish's, ‖∇g‖∞ at "
               "1e9 N/m (N), its move (m), the second route, and its hard residual over the start's:", ""]
@@ -217,16 +249,16 @@ def reference_tables(run):
     return lines
 
 
-def best_per_method(run):
-    """Each method's smallest error of its own kind within the cap: the residual (the k step's
-    families) or the hard residual (the hard family), with its K and time per step."""
-    scenes = [s["scene"] for s in run.scenes]
+def best_per_method(run, start):
+    """Each method's smallest error of its own kind within the cap from one start: the residual
+    (the k step's families) or the hard residual (the hard family), with its K and time per step."""
+    scenes = [s["scene"] for s in run.scenes if start_of(s) == start]
     rows = []
     for method in dict.fromkeys(r["method"] for r in run.runs):
         key = "relative_residual_hard" if run.family[method] == "hard" else "relative_residual"
         row = [method, "hard residual" if key.endswith("hard") else "residual"]
         for scene in scenes:
-            mine = [r for r in run.good(scene, method) if math.isfinite(number(r[key]))]
+            mine = [r for r in run.good(scene, method, start) if math.isfinite(number(r[key]))]
             if not mine:
                 row.append("—")
                 continue
@@ -237,13 +269,14 @@ def best_per_method(run):
     return table(["method", "its measure"] + scenes, rows)
 
 
-def newtons_per_k(run):
-    """The three Newtons per K on the curtains from 32² up: residual over the start's, time per step."""
+def newtons_per_k(run, start, smallest):
+    """The three Newtons per K on the curtains from smallest² up, from one start: residual over
+    the start's, time per step."""
     lines = []
     for s in run.scenes:
-        if scene_order(s["scene"])[0] != 1 or scene_order(s["scene"])[1] < 32:
+        if scene_order(s["scene"])[0] != 1 or scene_order(s["scene"])[1] < smallest or start_of(s) != start:
             continue
-        by = {m: {int(r["iterations"]): r for r in run.good(s["scene"], m)} for m in NEWTONS}
+        by = {m: {int(r["iterations"]): r for r in run.good(s["scene"], m, start)} for m in NEWTONS}
         ks = sorted(set().union(*[set(v) for v in by.values()]))
         if not ks:
             continue
@@ -256,7 +289,7 @@ def newtons_per_k(run):
                            + ("" if int(r["iterations_done"]) >= k else f" (stopped at {r['iterations_done']})")
                            if r else "")
             rows.append(row)
-        lines += [f"{s['scene']}:", ""] + table(["K"] + list(NEWTONS), rows) + [""]
+        lines += [f"{label(s['scene'], start)}:", ""] + table(["K"] + list(NEWTONS), rows) + [""]
     return lines
 
 
@@ -325,25 +358,29 @@ def contact(run):
 
 def bench_section(run, machine):
     lines = [BENCH_MARKERS[0], ""] + run.header(machine) + [""]
+    rough = " Rows marked (rough) are from the rough start." if "rough" in run.starts else ""
     lines += ["#### Fastest to each target", "",
               "The fastest run (median wall time per step) to each target; \"unresolved (spread s)\": the "
               "step has two minimisers s of its move apart, and a distance below s names a route, not a "
-              "solve; \"none reached\": no run within the step cap.", ""]
+              "solve; \"none reached\": no run within the step cap (" + run.caps() + "), with the best any "
+              "run reached." + rough, ""]
     lines += run.fastest_table(["max_strain", "relative_distance"]) + [""]
     lines += run.fastest_table(["relative_residual", "relative_residual_hard"]) + [""]
     lines += run.fastest_table(["relative_distance_hard"]) + [""]
     lines += ["#### The scenes' targets", ""] + reference_tables(run) + [""]
-    lines += ["#### Each method's best within the cap", "",
-              "The smallest residual of the method's own kind over the start's (the hard family: the hard "
-              "residual), with the K and the time per step of that run:", ""]
-    lines += best_per_method(run) + [""]
+    for start in run.starts:
+        lines += [f"#### Each method's best within the cap, from the {start} start", "",
+                  "The smallest residual of the method's own kind over the start's (the hard family: the hard "
+                  f"residual), with the K and the time per step of that run ({run.caps()}):", ""]
+        lines += best_per_method(run, start) + [""]
     lines += ["#### The Newtons per K", "",
               "Lab 06's Newton and lab 13's two variants: the residual over the start's and the median time "
-              "per step, per K, until the cap:", ""]
-    lines += newtons_per_k(run)
+              f"per step, per K, until the cap ({run.caps()}):", ""]
+    for start in run.starts:
+        lines += newtons_per_k(run, start, 32 if start == "trajectory" else 128)
     lines += ["#### Time per iteration against size", "",
-              "Per method the run with K nearest 10 (a direct solve: per step), fitted time ~ nᵖ over the "
-              "curtains:", ""]
+              f"Per method the run with K nearest 10 (a direct solve: per step) from the {run.starts[0]} start, "
+              "fitted time ~ nᵖ over the curtains:", ""]
     lines += scaling(run) + [""]
     if run.contact:
         lines += ["#### Contact (lab 14's drape)", ""] + contact(run)
@@ -361,8 +398,10 @@ def readme_section(run):
              "bench/README.md has the whole run). The fastest method to each max strain error, to the step's "
              "residual (over the start's: how well the implicit-Euler step is solved, whichever of its "
              "minimisers a method lands in) and to the distance from the reference step "
-             "(\"unresolved\": the step has two minimisers that far apart):", ""]
-    lines += run.fastest_table(["max_strain"]) + [""]
+             "(\"unresolved\": the step has two minimisers that far apart), one step from the "
+             + " and, in the rows marked (rough), from the ".join(f"{start} start" for start in run.starts)
+             + " (" + run.caps() + "):", ""]
+    lines += run.fastest_table(["max_strain"], run.starts[:1]) + [""]
     lines += run.fastest_table(["relative_residual", "relative_distance"]) + [""]
     exponents = ", ".join(f"{method} {p}" for method, p in exponent_list(run))
     lines += [f"Fitted exponents p of time per iteration ~ nᵖ on the curtains: {exponents}.", "", README_MARKERS[1]]

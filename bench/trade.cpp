@@ -3,10 +3,13 @@
 // (median of repeats), strain error, distance to a converged reference step,
 // the step's residual and objective gap (bench/step_residual.h: unlike the
 // distance, defined where the step has several minimisers), and the energy
-// drift over a fixed horizon. What each number means, and which
-// problem each method converges to: bench/README.md.
+// drift over a fixed horizon. Every step is measured from two starts: the
+// state an accurate trajectory reaches (the trajectory start, the default),
+// and a rough one where the stiff curtains are compressed and folded (the
+// hard case). What each number means, and which problem each method
+// converges to: bench/README.md.
 //
-//   trade [--quick] [--out DIR] [--scenes a,b] [--methods a,b] [--stiffness K] ...
+//   trade [--quick] [--out DIR] [--start trajectory|rough|both] [--scenes a,b] [--methods a,b] ...
 //
 // Writes DIR/trade.csv (one row per run), DIR/trade_scenes.csv (the scenes and
 // their reference steps), DIR/trade_fastest.csv (the fastest method to each
@@ -48,6 +51,16 @@ namespace {
 
 using cl::bench::Family;
 
+// The two starts every step is measured from (bench/README.md, "The two
+// starts"): the state an accurate trajectory reaches, and the rough one.
+enum class Start { kTrajectory, kRough };
+const char* start_name(Start start) { return start == Start::kTrajectory ? "trajectory" : "rough"; }
+
+// The step cap grows with the springs (a step's work does): 0.3 s (quick
+// 0.2 s) for 64²'s 16,002 springs, so 1.2 s on 128² and 73 ms on 32².
+constexpr double kCapSprings = 16002.0;
+constexpr double kCapSeconds = 0.3, kQuickCapSeconds = 0.2;
+
 struct Options {
   bool quick = false;
   std::string out = "out/bench";
@@ -57,7 +70,8 @@ struct Options {
   int repeats = 0;        // 0: 5 (quick 3)
   int horizon = 0;        // 0: 20 (quick 10)
   int warmup = 0;         // 0: 10 (quick 5)
-  double step_cap = 0.0;  // 0: 0.3 s (quick 0.05 s)
+  double step_cap = 0.0;  // 0: per scene, by its springs (kCapSprings)
+  std::string start;      // "trajectory", "rough" or "both"; empty: both (quick: trajectory)
   int threads = 1;        // OpenMP threads (the Jacobi and VBD sweeps)
 };
 
@@ -132,6 +146,7 @@ double rms_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
 
 struct Run {
   std::string scene, method;
+  Start start = Start::kTrajectory;
   std::string linear_solver;  // what the method's step factored with (StepOutcome)
   int iterations = 0, iterations_done = 0, repeats = 0, horizon_steps = 0;
   double step_seconds = 0, setup_seconds = 0;
@@ -157,6 +172,12 @@ struct Spread {
 
 struct SceneInfo {
   std::string name;
+  Start start = Start::kTrajectory;
+  double step_cap = 0.0;  // s, this scene's (kCapSprings)
+  // The trajectory start: lab 13's iterations over its steps, the polish's,
+  // and the largest |grad g| any step ended at (N); the start's wall time.
+  int start_iterations = 0, start_polish_iterations = 0;
+  double start_gradient = 0.0, start_seconds = 0.0;
   long long particles = 0, springs = 0;
   double reference_seconds = 0, reference_strain = 0, displacement = 0, energy_scale = 0;
   int reference_constrained_iterations = 0, reference_iterations = 0, hard_iterations = 0;
@@ -316,6 +337,63 @@ Polish newton_polish(const cl::lab06::Problem& problem, const Eigen::Matrix3Xd& 
     best_iterations = taken;
   }
   return {best, best_iterations, best_gradient};
+}
+
+// The trajectory start: `steps` steps from the scene's rest state, each the
+// implicit-Euler step solved to |grad g| <= 1e-8 N (lab 06's g) by lab 13's
+// constrained Newton as the lab gives it, warm from the step before (x⁰ the
+// step's start, λ⁰ the springs' forces there); where lab 13 stops short (no
+// step length lowers its merit, or 300 iterations), the reference's Newton
+// polish on g goes on from its end. This is where a simulation is when every
+// step was right. Throws when a step is not solved to 1e-8 N.
+struct TrajectoryStart {
+  cl::Particles particles;
+  int iterations = 0, polish_iterations = 0;  // over the steps
+  double worst_gradient = 0.0;               // the largest |grad g| a step ended at, N
+};
+
+TrajectoryStart trajectory_start(const cl::Scene& scene, int steps) {
+  constexpr double kTolerance = 1e-8;  // N
+  TrajectoryStart trajectory;
+  trajectory.particles = scene.particles;
+  cl::Particles& state = trajectory.particles;
+  const cl::lab06::Problem problem = cl::lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
+  const cl::lab13::Solver solver(scene.particles.inv_mass, scene.springs, scene.dt);
+  cl::lab13::Settings settings;
+  settings.gravity = scene.gravity;
+  settings.iterations = 300;
+  settings.tolerance = 0.0;
+  for (int step = 1; step <= steps; ++step) {
+    const Eigen::Matrix3Xd y = cl::lab06::predict(state, scene.gravity, scene.dt);
+    Eigen::Matrix3Xd x = state.x;
+    Eigen::VectorXd lambda = cl::lab13::warm_start(x, solver.springs(), {}, cl::lab13::Warm::kForces);
+    const cl::lab13::StepReport report =
+        solver.iterate(x, lambda, y, settings, [&](const cl::lab13::IterationRecord& record) {
+          return cl::lab06::newton_gradient(problem, *record.x, y).cwiseAbs().maxCoeff() <= kTolerance;
+        });
+    if (!report.problem.empty()) {
+      throw std::runtime_error(scene.name + ": trajectory start, step " + std::to_string(step) + ": " + report.problem);
+    }
+    trajectory.iterations += report.iterations_done;
+    double gradient = cl::lab06::newton_gradient(problem, x, y).cwiseAbs().maxCoeff();
+    if (gradient > kTolerance) {
+      const Polish polish = newton_polish(problem, y, x, gradient);
+      x = polish.x;
+      gradient = polish.gradient_norm;
+      trajectory.polish_iterations += polish.iterations;
+    }
+    if (!(gradient <= kTolerance)) {
+      throw std::runtime_error(scene.name + ": trajectory start, step " + std::to_string(step) + ": |grad g| " +
+                               format("%.1e", gradient) + " N after lab 13 and the polish, above 1e-8 N");
+    }
+    trajectory.worst_gradient = std::max(trajectory.worst_gradient, gradient);
+    for (Eigen::Index p = 0; p < x.cols(); ++p) {
+      state.v.col(p) = state.inv_mass[p] > 0.0 ? Eigen::Vector3d((x.col(p) - state.x.col(p)) / scene.dt)
+                                               : Eigen::Vector3d::Zero();
+    }
+    state.x = x;
+  }
+  return trajectory;
 }
 
 struct Reference {
@@ -568,8 +646,20 @@ int run(const Options& options) {
   contact.repeats = repeats;
   const int horizon = options.horizon > 0 ? options.horizon : (options.quick ? 10 : 20);
   const int warmup = options.warmup > 0 ? options.warmup : (options.quick ? 5 : 10);
-  const double cap = options.step_cap > 0.0 ? options.step_cap : (options.quick ? 0.05 : 0.3);
-  for (const std::string& name : scenes) make_scene(name, options.stiffness);  // bad names fail before any work
+  // The step cap: --step-cap on every scene, or by the scene's springs.
+  const double cap_per_spring = (options.quick ? kQuickCapSeconds : kCapSeconds) / kCapSprings;
+  std::vector<Start> starts;
+  const std::string start_option = options.start.empty() ? (options.quick ? "trajectory" : "both") : options.start;
+  if (start_option == "trajectory" || start_option == "both") starts.push_back(Start::kTrajectory);
+  if (start_option == "rough" || start_option == "both") starts.push_back(Start::kRough);
+  if (starts.empty()) {
+    throw cl::InputError("--start: '" + options.start + "' is not trajectory, rough or both");
+  }
+  std::string caps;  // the header's "curtain-64 300 ms, ..."
+  for (const std::string& name : scenes) {
+    const cl::Scene scene = make_scene(name, options.stiffness);  // bad names fail before any work
+    caps += (caps.empty() ? "" : ", ") + name + " " + time_text(cap_per_spring * static_cast<double>(scene.springs.size()));
+  }
   cl::start_run(options.out);
 #ifdef _OPENMP
   omp_set_num_threads(options.threads);
@@ -578,10 +668,13 @@ int run(const Options& options) {
 
   if (!contact_scenes.empty()) cl::bench::check_contact_trade(contact);
   if (!scenes.empty()) {
-    std::printf("trade: %zu scenes x %zu methods, k = %g N/m, %d repeats, horizon %d steps, warm-up %d steps, "
-                "K grows while a step takes < %s, %d thread(s)\n",
-                scenes.size(), methods.size(), options.stiffness, repeats, horizon, warmup, time_text(cap).c_str(),
-                options.threads);
+    const std::string cap_text =
+        options.step_cap > 0.0 ? time_text(options.step_cap) + " on every scene (--step-cap)"
+                               : time_text(cap_per_spring * kCapSprings) + " per 16002 springs (" + caps + ")";
+    std::printf("trade: %zu scenes x %zu methods, start %s, k = %g N/m, %d repeats, horizon %d steps (from the "
+                "trajectory start), warm-up %d steps, K grows while a step takes < %s, %d thread(s)\n",
+                scenes.size(), methods.size(), start_option.c_str(), options.stiffness, repeats, horizon, warmup,
+                cap_text.c_str(), options.threads);
   }
   std::fflush(stdout);
   const cl::Timer total;
@@ -592,207 +685,238 @@ int run(const Options& options) {
 
   for (std::size_t s = 0; s < scenes.size(); ++s) {
     const cl::Scene scene = make_scene(scenes[s], options.stiffness);
-    SceneInfo info;
-    info.name = scene.name;
-    info.particles = scene.particles.size();
-    info.springs = static_cast<long long>(scene.springs.size());
-    const std::string where = "[" + std::to_string(s + 1) + "/" + std::to_string(scenes.size()) + " " + scene.name + "]";
+    const double scene_cap =
+        options.step_cap > 0.0 ? options.step_cap : cap_per_spring * static_cast<double>(scene.springs.size());
+    for (const Start start_kind : starts) {
+      SceneInfo info;
+      info.name = scene.name;
+      info.start = start_kind;
+      info.step_cap = scene_cap;
+      info.particles = scene.particles.size();
+      info.springs = static_cast<long long>(scene.springs.size());
+      const std::string where = "[" + std::to_string(s + 1) + "/" + std::to_string(scenes.size()) + " " + scene.name +
+                                ", " + start_name(start_kind) + " start]";
+      const std::string label = scene.name + " (" + start_name(start_kind) + ")";
 
-    // The shared start: a few implicit-Euler steps from the scene's rest state
-    // (PD, 100 iterations: cheap once factored, and close enough to converged
-    // for a start), so that the springs carry load and the cloth moves. The
-    // reference step from there is Newton's, to round-off.
-    progress.show(where + " warm-up");
-    const cl::Timer warmup_timer;
-    std::unique_ptr<cl::bench::Stepper> warm = cl::bench::make_stepper("pd", scene, 100);
-    cl::Particles start = scene.particles;
-    for (int w = 0; w < warmup; ++w) {
-      const cl::bench::StepOutcome outcome = warm->step(start);
-      if (!outcome.problem.empty()) throw std::runtime_error(scene.name + ": warm-up: " + outcome.problem);
-    }
-    const Reference reference = reference_step(scene, start);
-    const cl::Particles& converged = reference.after;
-    info.reference_seconds = reference.seconds;
-    info.reference_constrained_iterations = reference.constrained_iterations;
-    info.reference_iterations = reference.newton_iterations;
-    info.reference_constrained_gradient = reference.constrained_gradient_norm;
-    info.reference_gradient = reference.gradient_norm;
-    info.reference_strain = cl::strain_stats(converged.x, scene.springs).max;
-    info.displacement = rms_distance(converged.x, start.x);
-    info.energy_scale = cl::energy_scale(start, scene.gravity, scene.dt);
-    progress.clear();
-    std::printf("%-12s warm-up and reference step (constrained newton %d iterations to |grad g| %.1e N, newton %d to "
-                "%.1e N, %s): %.1f s\n",
-                scene.name.c_str(), info.reference_constrained_iterations, info.reference_constrained_gradient,
-                info.reference_iterations, info.reference_gradient, time_text(info.reference_seconds).c_str(),
-                warmup_timer.seconds());
-    std::fflush(stdout);
-    progress.show(where + " second route");
-    const cl::lab06::Problem k_problem =
-        cl::lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
-    const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
-    info.spread = second_route(k_problem, start, y, converged.x, 1e-8);
-    progress.clear();
-    print_spread(scene.name, info.spread, "the reference");
-    progress.show(where + " hard step");
-    const HardStep hard = hard_step(scene, start, reference);
-    info.hard_iterations = hard.iterations;
-    info.hard_force_error = hard.force_error;
-    info.hard_constraint_error = hard.constraint_error;
-    info.hard_max_strain = hard.max_strain;
-    info.hard_seconds = hard.seconds;
-    info.hard_newton_iterations = hard.newton_iterations;
-    info.hard_gradient = hard.gradient_norm;
-    if (hard.x.cols() == start.x.cols()) info.hard_displacement = rms_distance(hard.x, start.x);
-    progress.clear();
-    if (info.hard_displacement > 0.0) {
-      std::printf("%-12s hard step (k = %.0e N/m, constrained newton %d iterations, force error %.1e, constraint "
-                  "error %.1e, then newton %d; |grad g| %.1e N, %s)\n",
-                  scene.name.c_str(), kHardStiffness, info.hard_iterations, info.hard_force_error, info.hard_constraint_error,
-                  info.hard_newton_iterations, info.hard_gradient, time_text(info.hard_seconds).c_str());
-    } else {
-      std::printf("%-12s hard step not computed: %s\n", scene.name.c_str(), hard.problem.c_str());
-    }
-    std::fflush(stdout);
-    if (info.hard_displacement > 0.0) {
-      progress.show(where + " second route to the hard step");
-      info.hard_spread = second_route(cl::lab06::make_problem(scene.particles.inv_mass, hard_springs(scene), scene.dt),
-                                      start, y, hard.x, 1e-6);
-      progress.clear();
-      print_spread(scene.name, info.hard_spread, "the hard step");
-    }
-    // The residuals' and the objective gap's scales: their values at the
-    // shared start, where every method begins (relative_residual = 1 there).
-    info.start_residual = cl::bench::step_residual(k_problem, start.x, y);
-    cl::SpdFactorization delassus;  // the hard residuals' J M⁻¹ Jᵀ: one pattern per scene
-    const cl::bench::HardResidual start_hard = cl::bench::hard_residual(k_problem, start.x, y, &delassus);
-    info.start_hard_violation = start_hard.violation;
-    info.start_hard_stationarity = start_hard.stationarity;
-    info.start_hard_residual = start_hard.norm();
-    const double reference_objective = cl::lab06::objective(k_problem, converged.x, y);
-    info.objective_drop = cl::lab06::objective(k_problem, start.x, y) - reference_objective;
-    info.reference_residual = cl::bench::step_residual(k_problem, converged.x, y) / info.start_residual;
-    if (info.hard_displacement > 0.0) {
-      const cl::bench::HardResidual at_hard = cl::bench::hard_residual(k_problem, hard.x, y, &delassus);
-      info.hard_step_residual = at_hard.norm() / info.start_hard_residual;
-    }
-    std::printf("%-12s at the start: step residual %.2e m, hard step's violation %.2e m and stationarity %.2e m; "
-                "g(start) - g(reference) %.3e J; relative residuals of the reference %.1e, of the hard step %.1e\n",
-                scene.name.c_str(), info.start_residual, info.start_hard_violation, info.start_hard_stationarity,
-                info.objective_drop, info.reference_residual, info.hard_step_residual);
-    std::fflush(stdout);
-    infos.push_back(info);
-
-    const std::size_t first_run = runs.size();
-    for (const std::string& method_name : methods) {
-      const cl::bench::MethodInfo& method = cl::bench::method_info(method_name);
-      if (method.grid_only && scene.grid_nx == 0) continue;
-      const bool elastic = method.family != Family::kHard;
-      const cl::Timer method_timer;
-      int done_runs = 0;
-      for (const int k : iteration_counts(method, options.quick)) {
-        progress.show(where + " " + method.name + " K=" + std::to_string(k) + "  (" +
-                      format("%.0f s", total.seconds()) + ")");
-        Run r;
-        r.scene = scene.name;
-        r.method = method.name;
-        r.iterations = k;
-        const cl::Timer setup;
-        std::unique_ptr<cl::bench::Stepper> stepper = cl::bench::make_stepper(method.name, scene, k);
-        r.setup_seconds = setup.seconds();
-
-        // Repeats of the one step from the shared start, with one solver (its
-        // factor and symbolic analysis reused, as in a run). The first repeat's
-        // result is the one measured.
-        std::vector<double> times;
-        cl::Particles one;
-        double timed = 0.0;
-        for (int rep = 0; rep < 200 && (rep < repeats || timed < 0.02); ++rep) {  // short steps: more repeats
-          cl::Particles state = start;
-          const cl::Timer step_timer;
-          const cl::bench::StepOutcome outcome = stepper->step(state);
-          times.push_back(step_timer.seconds());
-          timed += times.back();
-          if (rep == 0) {
-            one = state;
-            r.iterations_done = outcome.iterations;
-            r.problem = outcome.problem;
-            r.linear_solver = outcome.linear_solver;
-          }
-          if (!outcome.problem.empty() || times.front() > 2.0 * cap) break;  // slow: one timing will do
+      // The start (bench/README.md, "The two starts"): `warmup` steps from the
+      // scene's rest state, each solved to |grad g| <= 1e-8 N by lab 13 (the
+      // trajectory start), or of PD with 100 iterations (the rough start: on
+      // the stiff curtains it leaves the cloth compressed and folded). The
+      // reference step from there is lab 13's, to round-off.
+      progress.show(where + " warm-up");
+      const cl::Timer warmup_timer;
+      cl::Particles start = scene.particles;
+      if (start_kind == Start::kTrajectory) {
+        const TrajectoryStart trajectory = trajectory_start(scene, warmup);
+        start = trajectory.particles;
+        info.start_iterations = trajectory.iterations;
+        info.start_polish_iterations = trajectory.polish_iterations;
+        info.start_gradient = trajectory.worst_gradient;
+      } else {
+        std::unique_ptr<cl::bench::Stepper> warm = cl::bench::make_stepper("pd", scene, 100);
+        for (int w = 0; w < warmup; ++w) {
+          const cl::bench::StepOutcome outcome = warm->step(start);
+          if (!outcome.problem.empty()) throw std::runtime_error(scene.name + ": warm-up: " + outcome.problem);
         }
-        r.repeats = static_cast<int>(times.size());
-        r.step_seconds = median(times);
-        const cl::StrainStats strain = cl::strain_stats(one.x, scene.springs);
-        r.max_strain = strain.max;
-        r.rms_strain = strain.rms;
-        r.distance = rms_distance(one.x, converged.x);
-        r.distance_max = (one.x - converged.x).colwise().norm().maxCoeff();
-        r.relative_distance = info.displacement > 0.0 ? r.distance / info.displacement : 0.0;
-        r.relative_distance_hard = info.hard_displacement > 0.0
-                                       ? rms_distance(one.x, hard.x) / info.hard_displacement
-                                       : std::numeric_limits<double>::quiet_NaN();
-        // Residuals (bench/step_residual.h) over the start's, every run both:
-        // each family is judged by its own, as by its own distance.
-        const cl::Timer residual_timer;
-        r.residual_rms = cl::bench::step_residual(k_problem, one.x, y);
-        r.relative_residual = r.residual_rms / info.start_residual;
-        const cl::bench::HardResidual hard_residual = cl::bench::hard_residual(k_problem, one.x, y, &delassus);
-        r.hard_violation_rms = hard_residual.violation;
-        r.hard_stationarity_rms = hard_residual.stationarity;
-        r.relative_residual_hard = hard_residual.norm() / info.start_hard_residual;
-        r.objective_gap = (cl::lab06::objective(k_problem, one.x, y) - reference_objective) / info.objective_drop;
-        residual_seconds += residual_timer.seconds();
-
-        // The horizon: `horizon` steps from the shared start with one solver.
-        if (r.problem.empty()) {
-          std::unique_ptr<cl::bench::Stepper> runner = cl::bench::make_stepper(method.name, scene, k);
-          cl::Particles state = start;
-          const double e0 = total_energy(state, scene, elastic);
-          for (int step = 1; step <= horizon; ++step) {
-            const cl::bench::StepOutcome outcome = runner->step(state);
-            std::string trouble = outcome.problem;
-            if (trouble.empty()) trouble = cl::health_problem(state, cl::strain_stats(state.x, scene.springs));
-            if (!trouble.empty()) {
-              r.problem = "horizon step " + std::to_string(step) + ": " + trouble;
-              break;
-            }
-            r.horizon_steps = step;
-          }
-          r.energy_drift = total_energy(state, scene, elastic) - e0;
-          r.energy_drift_rel = info.energy_scale > 0.0 ? r.energy_drift / info.energy_scale : 0.0;
-        }
-        runs.push_back(r);
-        ++done_runs;
-        // More iterations would take too long, or change nothing (Newton stopped early).
-        if (r.step_seconds > cap || (method.iterative && r.iterations_done < k) || !r.problem.empty()) break;
       }
+      info.start_seconds = warmup_timer.seconds();
+      const Reference reference = reference_step(scene, start);
+      const cl::Particles& converged = reference.after;
+      info.reference_seconds = reference.seconds;
+      info.reference_constrained_iterations = reference.constrained_iterations;
+      info.reference_iterations = reference.newton_iterations;
+      info.reference_constrained_gradient = reference.constrained_gradient_norm;
+      info.reference_gradient = reference.gradient_norm;
+      info.reference_strain = cl::strain_stats(converged.x, scene.springs).max;
+      info.displacement = rms_distance(converged.x, start.x);
+      info.energy_scale = cl::energy_scale(start, scene.gravity, scene.dt);
       progress.clear();
-      const Run& last = runs.back();
-      std::printf("%-12s %-10s %2d runs, K up to %4d: max strain %.2e, %s per step  (%.1f s)\n", scene.name.c_str(),
-                  method.name.c_str(), done_runs, last.iterations, last.max_strain, time_text(last.step_seconds).c_str(),
-                  method_timer.seconds());
+      if (start_kind == Start::kTrajectory) {
+        std::printf("%-12s trajectory start: %d steps of constrained newton (%d iterations, then newton %d), each to "
+                    "|grad g| <= %.1e N (%s); step cap %s\n",
+                    scene.name.c_str(), warmup, info.start_iterations, info.start_polish_iterations, info.start_gradient,
+                    time_text(info.start_seconds).c_str(), time_text(scene_cap).c_str());
+      } else {
+        std::printf("%-12s rough start: %d steps of pd (100 iterations) (%s); step cap %s\n", scene.name.c_str(), warmup,
+                    time_text(info.start_seconds).c_str(), time_text(scene_cap).c_str());
+      }
+      std::printf("%-12s reference step (constrained newton %d iterations to |grad g| %.1e N, newton %d to %.1e N, %s)\n",
+                  label.c_str(), info.reference_constrained_iterations, info.reference_constrained_gradient,
+                  info.reference_iterations, info.reference_gradient, time_text(info.reference_seconds).c_str());
       std::fflush(stdout);
+      progress.show(where + " second route");
+      const cl::lab06::Problem k_problem =
+          cl::lab06::make_problem(scene.particles.inv_mass, scene.springs, scene.dt);
+      const Eigen::Matrix3Xd y = cl::lab06::predict(start, scene.gravity, scene.dt);
+      info.spread = second_route(k_problem, start, y, converged.x, 1e-8);
+      progress.clear();
+      print_spread(label, info.spread, "the reference");
+      progress.show(where + " hard step");
+      const HardStep hard = hard_step(scene, start, reference);
+      info.hard_iterations = hard.iterations;
+      info.hard_force_error = hard.force_error;
+      info.hard_constraint_error = hard.constraint_error;
+      info.hard_max_strain = hard.max_strain;
+      info.hard_seconds = hard.seconds;
+      info.hard_newton_iterations = hard.newton_iterations;
+      info.hard_gradient = hard.gradient_norm;
+      if (hard.x.cols() == start.x.cols()) info.hard_displacement = rms_distance(hard.x, start.x);
+      progress.clear();
+      if (info.hard_displacement > 0.0) {
+        std::printf("%-12s hard step (k = %.0e N/m, constrained newton %d iterations, force error %.1e, constraint "
+                    "error %.1e, then newton %d; |grad g| %.1e N, %s)\n",
+                    label.c_str(), kHardStiffness, info.hard_iterations, info.hard_force_error, info.hard_constraint_error,
+                    info.hard_newton_iterations, info.hard_gradient, time_text(info.hard_seconds).c_str());
+      } else {
+        std::printf("%-12s hard step not computed: %s\n", label.c_str(), hard.problem.c_str());
+      }
+      std::fflush(stdout);
+      if (info.hard_displacement > 0.0) {
+        progress.show(where + " second route to the hard step");
+        info.hard_spread = second_route(cl::lab06::make_problem(scene.particles.inv_mass, hard_springs(scene), scene.dt),
+                                        start, y, hard.x, 1e-6);
+        progress.clear();
+        print_spread(label, info.hard_spread, "the hard step");
+      }
+      // The residuals' and the objective gap's scales: their values at the
+      // start, where every method begins (relative_residual = 1 there).
+      info.start_residual = cl::bench::step_residual(k_problem, start.x, y);
+      cl::SpdFactorization delassus;  // the hard residuals' J M⁻¹ Jᵀ: one pattern per scene
+      const cl::bench::HardResidual start_hard = cl::bench::hard_residual(k_problem, start.x, y, &delassus);
+      info.start_hard_violation = start_hard.violation;
+      info.start_hard_stationarity = start_hard.stationarity;
+      info.start_hard_residual = start_hard.norm();
+      const double reference_objective = cl::lab06::objective(k_problem, converged.x, y);
+      info.objective_drop = cl::lab06::objective(k_problem, start.x, y) - reference_objective;
+      info.reference_residual = cl::bench::step_residual(k_problem, converged.x, y) / info.start_residual;
+      if (info.hard_displacement > 0.0) {
+        const cl::bench::HardResidual at_hard = cl::bench::hard_residual(k_problem, hard.x, y, &delassus);
+        info.hard_step_residual = at_hard.norm() / info.start_hard_residual;
+      }
+      std::printf("%-12s at the start: step residual %.2e m, hard step's violation %.2e m and stationarity %.2e m; "
+                  "g(start) - g(reference) %.3e J; relative residuals of the reference %.1e, of the hard step %.1e\n",
+                  label.c_str(), info.start_residual, info.start_hard_violation, info.start_hard_stationarity,
+                  info.objective_drop, info.reference_residual, info.hard_step_residual);
+      std::fflush(stdout);
+      infos.push_back(info);
+
+      const std::size_t first_run = runs.size();
+      for (const std::string& method_name : methods) {
+        const cl::bench::MethodInfo& method = cl::bench::method_info(method_name);
+        if (method.grid_only && scene.grid_nx == 0) continue;
+        const bool elastic = method.family != Family::kHard;
+        const cl::Timer method_timer;
+        int done_runs = 0;
+        for (const int k : iteration_counts(method, options.quick)) {
+          progress.show(where + " " + method.name + " K=" + std::to_string(k) + "  (" +
+                        format("%.0f s", total.seconds()) + ")");
+          Run r;
+          r.scene = scene.name;
+          r.start = start_kind;
+          r.method = method.name;
+          r.iterations = k;
+          const cl::Timer setup;
+          std::unique_ptr<cl::bench::Stepper> stepper = cl::bench::make_stepper(method.name, scene, k);
+          r.setup_seconds = setup.seconds();
+
+          // Repeats of the one step from the start, with one solver (its factor
+          // and symbolic analysis reused, as in a run). The first repeat's
+          // result is the one measured.
+          std::vector<double> times;
+          cl::Particles one;
+          double timed = 0.0;
+          for (int rep = 0; rep < 200 && (rep < repeats || timed < 0.02); ++rep) {  // short steps: more repeats
+            cl::Particles state = start;
+            const cl::Timer step_timer;
+            const cl::bench::StepOutcome outcome = stepper->step(state);
+            times.push_back(step_timer.seconds());
+            timed += times.back();
+            if (rep == 0) {
+              one = state;
+              r.iterations_done = outcome.iterations;
+              r.problem = outcome.problem;
+              r.linear_solver = outcome.linear_solver;
+            }
+            if (!outcome.problem.empty() || times.front() > 2.0 * scene_cap) break;  // slow: one timing will do
+          }
+          r.repeats = static_cast<int>(times.size());
+          r.step_seconds = median(times);
+          const cl::StrainStats strain = cl::strain_stats(one.x, scene.springs);
+          r.max_strain = strain.max;
+          r.rms_strain = strain.rms;
+          r.distance = rms_distance(one.x, converged.x);
+          r.distance_max = (one.x - converged.x).colwise().norm().maxCoeff();
+          r.relative_distance = info.displacement > 0.0 ? r.distance / info.displacement : 0.0;
+          r.relative_distance_hard = info.hard_displacement > 0.0
+                                         ? rms_distance(one.x, hard.x) / info.hard_displacement
+                                         : std::numeric_limits<double>::quiet_NaN();
+          // Residuals (bench/step_residual.h) over the start's, every run both:
+          // each family is judged by its own, as by its own distance.
+          const cl::Timer residual_timer;
+          r.residual_rms = cl::bench::step_residual(k_problem, one.x, y);
+          r.relative_residual = r.residual_rms / info.start_residual;
+          const cl::bench::HardResidual hard_residual = cl::bench::hard_residual(k_problem, one.x, y, &delassus);
+          r.hard_violation_rms = hard_residual.violation;
+          r.hard_stationarity_rms = hard_residual.stationarity;
+          r.relative_residual_hard = hard_residual.norm() / info.start_hard_residual;
+          r.objective_gap = (cl::lab06::objective(k_problem, one.x, y) - reference_objective) / info.objective_drop;
+          residual_seconds += residual_timer.seconds();
+
+          // The horizon: `horizon` steps with one solver, from the trajectory
+          // start only (a trajectory goes on from a state like it; the rough
+          // start is the one step's hard case).
+          if (start_kind != Start::kTrajectory) {
+          r.energy_drift = r.energy_drift_rel = std::numeric_limits<double>::quiet_NaN();
+        } else if (r.problem.empty()) {
+            std::unique_ptr<cl::bench::Stepper> runner = cl::bench::make_stepper(method.name, scene, k);
+            cl::Particles state = start;
+            const double e0 = total_energy(state, scene, elastic);
+            for (int step = 1; step <= horizon; ++step) {
+              const cl::bench::StepOutcome outcome = runner->step(state);
+              std::string trouble = outcome.problem;
+              if (trouble.empty()) trouble = cl::health_problem(state, cl::strain_stats(state.x, scene.springs));
+              if (!trouble.empty()) {
+                r.problem = "horizon step " + std::to_string(step) + ": " + trouble;
+                break;
+              }
+              r.horizon_steps = step;
+            }
+            r.energy_drift = total_energy(state, scene, elastic) - e0;
+            r.energy_drift_rel = info.energy_scale > 0.0 ? r.energy_drift / info.energy_scale : 0.0;
+          }
+          runs.push_back(r);
+          ++done_runs;
+          // More iterations would take too long, or change nothing (Newton stopped early).
+          if (r.step_seconds > scene_cap || (method.iterative && r.iterations_done < k) || !r.problem.empty()) break;
+        }
+        progress.clear();
+        const Run& last = runs.back();
+        std::printf("%-12s %-10s %2d runs, K up to %4d: max strain %.2e, %s per step  (%.1f s)\n", label.c_str(),
+                    method.name.c_str(), done_runs, last.iterations, last.max_strain, time_text(last.step_seconds).c_str(),
+                    method_timer.seconds());
+        std::fflush(stdout);
+      }
+      mark_front(runs, first_run);
     }
-    mark_front(runs, first_run);
   }
   progress.clear();
   if (!contact_scenes.empty()) cl::bench::run_contact_trade(contact);
   if (scenes.empty()) return 0;  // only drape scenes: trade_contact.csv is their output
 
   // ---------------------------------------------------------------- output
-  cl::CsvTable table({"scene", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
+  cl::CsvTable table({"scene", "start", "particles", "springs", "method", "family", "lab", "linear_solver", "iterations", "iterations_done",
                       "step_seconds", "seconds_per_iteration", "repeats", "setup_seconds", "max_strain", "rms_strain",
                       "distance_rms", "distance_max", "relative_distance", "relative_distance_hard", "residual_rms",
                       "relative_residual", "hard_violation_rms", "hard_stationarity_rms", "relative_residual_hard",
                       "objective_gap", "horizon_steps", "energy_drift", "energy_drift_rel", "on_front", "problem"});
-  auto info_of = [&](const std::string& name) -> const SceneInfo& {
-    return *std::find_if(infos.begin(), infos.end(), [&](const SceneInfo& i) { return i.name == name; });
+  auto info_of = [&](const Run& r) -> const SceneInfo& {
+    return *std::find_if(infos.begin(), infos.end(),
+                         [&](const SceneInfo& i) { return i.name == r.scene && i.start == r.start; });
   };
   for (const Run& r : runs) {
     const cl::bench::MethodInfo& method = cl::bench::method_info(r.method);
-    const SceneInfo& info = info_of(r.scene);
-    table.add_row({r.scene, info.particles, info.springs, r.method, std::string(cl::bench::family_name(method.family)),
+    const SceneInfo& info = info_of(r);
+    table.add_row({r.scene, std::string(start_name(r.start)), info.particles, info.springs, r.method, std::string(cl::bench::family_name(method.family)),
                    method.lab, r.linear_solver, static_cast<long long>(r.iterations), static_cast<long long>(r.iterations_done),
                    r.step_seconds, r.step_seconds / std::max(1, r.iterations_done), static_cast<long long>(r.repeats),
                    r.setup_seconds, r.max_strain, r.rms_strain, r.distance, r.distance_max, r.relative_distance, r.relative_distance_hard,
@@ -803,7 +927,9 @@ int run(const Options& options) {
   }
   table.write(cl::join_path(options.out, "trade.csv"));
 
-  cl::CsvTable scene_table({"scene", "particles", "springs", "stiffness", "dt", "warmup_steps", "reference_constrained_newton_iterations",
+  cl::CsvTable scene_table({"scene", "start", "particles", "springs", "stiffness", "dt", "warmup_steps", "step_cap",
+                            "start_constrained_newton_iterations", "start_newton_iterations", "start_gradient_norm",
+                            "start_seconds", "reference_constrained_newton_iterations",
                             "reference_constrained_gradient_norm", "reference_newton_iterations", "reference_gradient_norm",
                             "reference_seconds", "reference_max_strain", "step_displacement_rms", "energy_scale",
                             "hard_iterations", "hard_force_error", "hard_constraint_error", "hard_max_strain",
@@ -814,8 +940,11 @@ int run(const Options& options) {
                             "start_residual", "start_hard_violation", "start_hard_stationarity", "objective_drop",
                             "reference_relative_residual", "hard_relative_residual_hard"});
   for (const SceneInfo& info : infos) {
-    scene_table.add_row({info.name, info.particles, info.springs, options.stiffness, 1.0 / 60.0,
-                         static_cast<long long>(warmup), static_cast<long long>(info.reference_constrained_iterations),
+    scene_table.add_row({info.name, std::string(start_name(info.start)), info.particles, info.springs,
+                         options.stiffness, 1.0 / 60.0, static_cast<long long>(warmup), info.step_cap,
+                         static_cast<long long>(info.start_iterations),
+                         static_cast<long long>(info.start_polish_iterations), info.start_gradient, info.start_seconds,
+                         static_cast<long long>(info.reference_constrained_iterations),
                          info.reference_constrained_gradient, static_cast<long long>(info.reference_iterations),
                          info.reference_gradient,
                          info.reference_seconds, info.reference_strain, info.displacement, info.energy_scale,
@@ -855,7 +984,7 @@ int run(const Options& options) {
       default: return r.relative_residual_hard;
     }
   };
-  cl::CsvTable fastest({"scene", "measure", "target", "method", "iterations", "step_seconds", "value"});
+  cl::CsvTable fastest({"scene", "start", "measure", "target", "method", "iterations", "step_seconds", "value"});
   // best[measure][scene][target]
   std::vector<std::vector<std::vector<const Run*>>> best(
       kMeasures, std::vector<std::vector<const Run*>>(infos.size(), std::vector<const Run*>(kTargets, nullptr)));
@@ -872,36 +1001,37 @@ int run(const Options& options) {
       for (std::size_t t = 0; t < kTargets; ++t) {
         const Run*& b = best[static_cast<std::size_t>(m)][s][t];
         if (unresolved(m, s, t)) {
-          fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], std::string("unresolved"), 0LL, 0.0,
+          fastest.add_row({infos[s].name, std::string(start_name(infos[s].start)), std::string(measures[m]), targets[t], std::string("unresolved"), 0LL, 0.0,
                            spread_of(m, s)});
           continue;
         }
         for (const Run& r : runs) {
-          if (r.scene != infos[s].name || !r.problem.empty() || !(value_of(r, m) <= targets[t])) continue;
+          if (r.scene != infos[s].name || r.start != infos[s].start || !r.problem.empty() || !(value_of(r, m) <= targets[t])) continue;
           if (!b || r.step_seconds < b->step_seconds) b = &r;
         }
         if (b) {
-          fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], b->method,
+          fastest.add_row({infos[s].name, std::string(start_name(infos[s].start)), std::string(measures[m]), targets[t], b->method,
                            static_cast<long long>(b->iterations), b->step_seconds, value_of(*b, m)});
         } else {
-          fastest.add_row({infos[s].name, std::string(measures[m]), targets[t], std::string("none"), 0LL, 0.0, 0.0});
+          fastest.add_row({infos[s].name, std::string(start_name(infos[s].start)), std::string(measures[m]), targets[t], std::string("none"), 0LL, 0.0, 0.0});
         }
       }
     }
   }
   fastest.write(cl::join_path(options.out, "trade_fastest.csv"));
 
-  // Time per iteration against size, on the curtains: per method the run with
+  // Time per iteration against size, on the curtains, from the first start
+  // run (the trajectory start's when both are): per method the run with
   // the iteration count nearest 10 (a direct solve: its one solve).
   cl::CsvTable scaling({"method", "scene", "particles", "springs", "iterations_done", "seconds_per_iteration"});
   std::vector<std::pair<std::string, std::pair<double, int>>> exponents;
   for (const std::string& method_name : methods) {
     std::vector<double> log_n, log_t;
     for (const SceneInfo& info : infos) {
-      if (info.name.rfind("curtain-", 0) != 0) continue;
+      if (info.name.rfind("curtain-", 0) != 0 || info.start != starts.front()) continue;
       const Run* pick = nullptr;
       for (const Run& r : runs) {
-        if (r.scene != info.name || r.method != method_name || r.iterations_done < 1) continue;
+        if (r.scene != info.name || r.start != info.start || r.method != method_name || r.iterations_done < 1) continue;
         if (!pick || std::abs(std::log(r.iterations / 10.0)) < std::abs(std::log(pick->iterations / 10.0))) pick = &r;
       }
       if (!pick) continue;
@@ -937,7 +1067,7 @@ int run(const Options& options) {
     };
     const std::string low = bound(targets[0]), high = bound(targets[1]);
     std::printf("fastest method to %s %s and %s (median wall time per step):\n", titles[m], low.c_str(), high.c_str());
-    std::printf("  %-12s %-30s %-30s\n", "scene", low.c_str(), high.c_str());
+    std::printf("  %-24s %-30s %-30s\n", "scene", low.c_str(), high.c_str());
     for (std::size_t s = 0; s < infos.size(); ++s) {
       std::string cells[kTargets];
       for (std::size_t t = 0; t < kTargets; ++t) {
@@ -951,7 +1081,8 @@ int run(const Options& options) {
                            " " + time_text(b->step_seconds)
                      : "none reached";
       }
-      std::printf("  %-12s %-30s %-30s\n", infos[s].name.c_str(), cells[0].c_str(), cells[1].c_str());
+      const std::string label = infos[s].name + (starts.size() > 1 ? std::string(" (") + start_name(infos[s].start) + ")" : "");
+      std::printf("  %-24s %-30s %-30s\n", label.c_str(), cells[0].c_str(), cells[1].c_str());
     }
   }
   if (!exponents.empty()) {
@@ -991,8 +1122,13 @@ int main(int argc, char** argv) {
       .range(1, 1'000'000);
   app.add_option("--warmup", options.warmup, "PD steps (100 iterations) before the shared start (default 10, quick 5)")
       .range(1, 1'000'000);
-  app.add_option("--step-cap", options.step_cap, "stop raising K once a step takes this long, s (default 0.3, quick 0.05)")
+  app.add_option("--step-cap", options.step_cap,
+                 "stop raising K once a step takes this long, s, on every scene (default by the scene's springs: "
+                 "0.3 s, quick 0.2 s, per 16002 springs, 64²'s)")
       .positive();
+  app.add_option("--start", options.start,
+                 "trajectory (10 steps from rest, each solved to |grad g| <= 1e-8 N by lab 13), rough (10 steps of PD, "
+                 "100 iterations) or both (default both; quick trajectory)");
   app.add_option("--threads", options.threads,
                  "OpenMP threads of the parallel sweeps and BLAS threads of CHOLMOD (1: comparable timings on a shared machine)")
       .range(1, 256)

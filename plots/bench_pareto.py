@@ -1,15 +1,15 @@
 #!/usr/bin/env python3
 """The speed/accuracy trade (issue 12): per scene, error against wall time per
-step for every method and iteration count, the Pareto front highlighted. Top
-row: max strain error; middle row: distance to the converged reference step,
-relative to the step's displacement; bottom row (when trade.csv has it): the
-same for the hard step, the hard family's own target; then (when trade.csv has
-them) the step's residual and the hard step's, each over the shared start's,
-with their targets 1e-3 and 1e-6 (a residual is 0 at every solution alike, so
-it resolves every scene). Where a scene's step has two minimisers
-(trade_scenes.csv's reference_spread and hard_spread), the distances below
-their spread are shaded: unresolved. Reads
-OUTDIR/bench/trade.csv and trade_scenes.csv, writes OUTDIR/bench/pareto.png."""
+step for every method and iteration count, the Pareto front highlighted. One
+panel per start (trade.csv's `start`: the trajectory start, then the rough
+one), one column per scene. Rows: the max strain error; the step's residual
+over the start's, with its targets 1e-3 and 1e-6 (0 at every solution alike,
+so it resolves every scene); the distance to the converged reference step,
+relative to the step's displacement. Where a scene's step has two minimisers
+(trade_scenes.csv's reference_spread), the distances below the spread are
+shaded: unresolved. (The hard step's distance and residual are in the CSV and
+bench/README.md's tables.) Reads OUTDIR/bench/trade.csv and trade_scenes.csv,
+writes OUTDIR/bench/pareto.png."""
 import math
 from pathlib import Path
 
@@ -39,26 +39,55 @@ def main(out_dir):
     scene_table = bench / "trade_scenes.csv"
     if figures.up_to_date(target, [table] + ([scene_table] if scene_table.exists() else [])):
         return 0
-    spread = {}  # (measure, scene) -> the two routes' spread, where it is above round-off
+    spread = {}  # (measure, scene, start) -> the two routes' spread, where it is above round-off
     if scene_table.exists():
         for r in figures.rows(scene_table):
             for key, column in (("relative_distance", "reference_spread"), ("relative_distance_hard", "hard_spread")):
                 value = float(r.get(column) or "nan")
                 if math.isfinite(value) and value > 1e-6:
-                    spread[(key, r["scene"])] = value
+                    spread[(key, r["scene"], r.get("start") or "rough")] = value
     rows = [r for r in figures.rows(table) if not r["problem"]]
+    for r in rows:
+        r.setdefault("start", "rough")  # runs before the column were from the rough start
+        r["start"] = r["start"] or "rough"
+    starts = [s for s in ("trajectory", "rough") if any(r["start"] == s for r in rows)]
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     methods = list(dict.fromkeys(r["method"] for r in rows))
     colors = {m: plt.cm.tab20(i % 20) for i, m in enumerate(methods)}
     distance_levels, residual_levels = (1e-2, 1e-3), (1e-3, 1e-6)
-    measures = [("max_strain", "max strain error", distance_levels),
-                ("relative_distance", "distance to reference step\n/ step displacement", distance_levels)]
-    optional = [("relative_distance_hard", "distance to hard step\n/ its displacement", distance_levels),
-                ("relative_residual", "step residual Δt²‖∇g‖_M⁻¹\n/ the start's", residual_levels),
-                ("relative_residual_hard", "hard step residual\n/ the start's", residual_levels)]
-    measures += [m for m in optional if rows and m[0] in rows[0]]
-    figure, axes = plt.subplots(len(measures), len(scenes), figsize=(3.9 * len(scenes), 3.8 * len(measures)),
-                                squeeze=False)
+    measures = [("max_strain", "max strain error", distance_levels)]
+    if rows and "relative_residual" in rows[0]:
+        measures.append(("relative_residual", "step residual Δt²‖∇g‖_M⁻¹\n/ the start's", residual_levels))
+    measures.append(("relative_distance", "distance to reference step\n/ step displacement", distance_levels))
+    panel_height = 3.6 * len(measures)
+    figure = plt.figure(figsize=(3.9 * len(scenes), panel_height * len(starts) + 1.8))
+    # One subfigure per start, and one for the legend below them.
+    parts = figure.subfigures(len(starts) + 1, 1, squeeze=False,
+                              height_ratios=[panel_height] * len(starts) + [1.8])[:, 0]
+    all_axes = []
+    for start, panel in zip(starts, parts):
+        axes = panel.subplots(len(measures), len(scenes), squeeze=False)
+        all_axes.append(axes)
+        panel.suptitle(f"From the {start} start" + (" (10 accurate steps from rest)" if start == "trajectory"
+                                                    else " (10 steps of PD, 100 iterations: compressed and folded)")
+                       + "\nerror against time per step, K growing along each line (circles: the Pareto front)",
+                       fontsize=11)
+        draw_panel(axes, [r for r in rows if r["start"] == start], scenes, methods, colors, measures,
+                   {(key, scene): value for (key, scene, s), value in spread.items() if s == start})
+    handles, labels = [], []
+    for axes in all_axes:
+        for ax in axes.flat:
+            for h, lab in zip(*ax.get_legend_handles_labels()):
+                if lab not in labels:
+                    handles.append(h)
+                    labels.append(lab)
+    parts[-1].legend(handles, labels, loc="center", ncol=min(len(labels), 5), fontsize=8)
+    figures.save(figure, target, dpi=80)
+    return 0
+
+
+def draw_panel(axes, rows, scenes, methods, colors, measures, spread):
+    """One start's grid: a column per scene, a row per measure."""
     for column, scene in enumerate(scenes):
         mine = [r for r in rows if r["scene"] == scene]
         for row, (key, label, levels) in enumerate(measures):
@@ -92,18 +121,6 @@ def main(out_dir):
             if row == 0:
                 ax.set_title(scene)
             ax.grid(True, which="major", alpha=0.3)
-    handles, labels = axes[0][-1].get_legend_handles_labels()
-    for ax in axes.flat:
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            if lab not in labels:
-                handles.append(h)
-                labels.append(lab)
-    figure.legend(handles, labels, loc="lower center", ncol=min(len(labels), 5), fontsize=8)
-    figure.suptitle("Error against time per step: one step from a shared state, K growing along each line "
-                    "(circles: the Pareto front)", fontsize=11)
-    figure.tight_layout(rect=(0, 0.09, 1, 0.96))
-    figures.save(figure, target, dpi=100)
-    return 0
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,12 +18,45 @@ namespace cl::lab13 {
 
 namespace {
 
+// Constrained Newton converges every step while each finite spring's
+// dt^2 k (1/m_i + 1/m_j) is at most kMaxStiffnessRatio (run.h); above it a
+// run is refused here, before any step, instead of stalling and diverging.
+void require_stiffness_in_range(const Scene& scene, const LabOptions& lab) {
+  static_assert(kMaxStiffnessRatio == 1e8, "the message below says 1e8");
+  const double dt2 = scene.dt * scene.dt;
+  double top = std::numeric_limits<double>::infinity();  // the largest k in range, N/m
+  int worst = -1;
+  double worst_ratio = 0.0;
+  for (std::size_t e = 0; e < scene.springs.size(); ++e) {
+    const Spring& s = scene.springs[e];
+    const double inverse_masses = scene.particles.inv_mass[s.i] + scene.particles.inv_mass[s.j];
+    if (!std::isfinite(s.stiffness) || !(inverse_masses > 0.0)) continue;
+    top = std::min(top, kMaxStiffnessRatio / (dt2 * inverse_masses));
+    const double ratio = dt2 * s.stiffness * inverse_masses;
+    if (ratio > worst_ratio) {
+      worst_ratio = ratio;
+      worst = static_cast<int>(e);
+    }
+  }
+  if (worst < 0 || worst_ratio <= kMaxStiffnessRatio) return;
+  const std::string what = lab.stiffness.empty() ? "springs[" + std::to_string(worst) + "].stiffness" : "--stiffness";
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "%s: %.3g N/m is above the range where constrained Newton converges on this scene at dt = %.3g s: "
+                "finite k up to %.2g N/m (dt^2 k (1/m_i + 1/m_j) <= 1e8, kMaxStiffnessRatio; README.md, \"Where it "
+                "holds\"), a smaller --dt for a stiffer k, or inf",
+                what.c_str(), scene.springs[static_cast<std::size_t>(worst)].stiffness, scene.dt, top);
+  throw InputError(text);
+}
+
 Scene load(const std::string& scene_dir, const CommonOptions& options, const LabOptions& lab) {
   Scene scene = load_scene_for(options, scene_dir);
   if (!lab.stiffness.empty()) set_stiffness(scene, parse_stiffness("--stiffness", lab.stiffness));
   if (options.method != "constrained-newton") {
     require_finite_springs(scene, "lab 06's " + options.method +
                                       " minimises finite springs' energy (use --method constrained-newton)");
+  } else {
+    require_stiffness_in_range(scene, lab);
   }
   return scene;
 }
