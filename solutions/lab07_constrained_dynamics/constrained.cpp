@@ -143,6 +143,7 @@ SparseMatrix constraint_jacobian(const Eigen::Matrix3Xd& x, const std::vector<Sp
     const Spring& s = springs[e];
     const Eigen::Vector3d d = x.col(s.i) - x.col(s.j);
     const double length = d.norm();
+    if (!(length > 0.0)) continue;  // coincident: no direction, empty row
     const Eigen::Vector3d n = d / length;
     finite = finite && n.allFinite();
     const auto row = static_cast<Eigen::Index>(e);
