@@ -308,10 +308,10 @@ MISTAKES_WHOLE = 2
 
 def check_mistakes(checks, labs):
     with_catalogue = [lab for lab in labs if catalogue(lab)]
-    whole, first = with_catalogue[-MISTAKES_WHOLE:], with_catalogue[:-MISTAKES_WHOLE]
+    whole = with_catalogue[-MISTAKES_WHOLE:]
     try:
-        results = {**run_mistakes(first, limit=1, log=lambda _line: None),
-                   **run_mistakes(whole, log=lambda _line: None)}
+        results = run_mistakes(with_catalogue, limit={lab: None if lab in whole else 1 for lab in with_catalogue},
+                               log=lambda _line: None)
     except CourseError as error:
         checks.record(False, f"mistakes: {error}", error.details)
         return
