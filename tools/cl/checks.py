@@ -7,7 +7,7 @@ import shutil
 import subprocess
 import tempfile
 import time
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 
 from . import grade
@@ -25,9 +25,16 @@ from .measure import check_measurements
 from .mistakes import catalogue, run_mistakes
 from .plots import run_plots
 from .release import is_release
-from .sanitize import check_sanitize, start_sanitize
+from .sanitize import background_cpu, check_sanitize, start_sanitize
 from .student_loop import check_student_loop
 from .view_checks import check_browser
+
+
+def foreground_cpu():
+    """CPU seconds (user + system) of this process and of the children it has
+    waited for, less those of the background sanitizer's (counted apart)."""
+    times = os.times()
+    return times.user + times.system + times.children_user + times.children_system - background_cpu()
 
 
 class Checks:
@@ -37,18 +44,19 @@ class Checks:
         self.passed = 0
         self.failed = 0
         self.started = time.monotonic()
-        self.times = []  # (step, seconds, ran alongside other steps)
+        self.cpu_started = foreground_cpu()
+        self.times = []  # (step, seconds, CPU seconds or None, ran alongside other steps)
 
     @contextmanager
     def timed(self, step):
-        start = time.monotonic()
+        start, cpu = time.monotonic(), foreground_cpu()
         try:
             yield
         finally:
-            self.add_time(step, time.monotonic() - start)
+            self.add_time(step, time.monotonic() - start, cpu=foreground_cpu() - cpu)
 
-    def add_time(self, step, seconds, concurrent=False):
-        self.times.append((step, seconds, concurrent))
+    def add_time(self, step, seconds, concurrent=False, cpu=None):
+        self.times.append((step, seconds, cpu, concurrent))
 
     def record(self, ok, name, details=()):
         if ok:
@@ -66,13 +74,17 @@ class Checks:
         if not self.times:
             return
         rest = "(the rest: listing, waiting, Python)"
-        width = max(len(step) for step, _, _ in [*self.times, (rest, 0, False)])
-        print(f"\ntiming: {total:.0f} s in all")
-        for step, seconds, concurrent in self.times:
+        width = max(len(step) for step, *_ in [*self.times, (rest,)])
+        cpu_total = foreground_cpu() - self.cpu_started + background_cpu()
+        print(f"\ntiming: {total:.0f} s in all, {cpu_total:.0f} s of CPU (user + system, every process; "
+              f"load at the end {os.getloadavg()[0]:.2f})")
+        print(f"  {'step':<{width}}  {'wall':>9}  {'CPU':>9}  share of the wall time")
+        for step, seconds, cpu, concurrent in self.times:
             share = "alongside" if concurrent else f"{100 * seconds / total:5.1f} %"
-            print(f"  {step:<{width}}  {seconds:7.1f} s  {share}")
-        counted = sum(seconds for _, seconds, concurrent in self.times if not concurrent)
-        print(f"  {rest:<{width}}  {total - counted:7.1f} s  "
+            used = "-" if cpu is None else f"{cpu:.1f} s"
+            print(f"  {step:<{width}}  {seconds:7.1f} s  {used:>9}  {share}")
+        counted = sum(seconds for _, seconds, _, concurrent in self.times if not concurrent)
+        print(f"  {rest:<{width}}  {total - counted:7.1f} s  {'':>9}  "
               f"{100 * (total - counted) / total:5.1f} %")
 
     def finish(self):
@@ -193,10 +205,10 @@ def report_student_score(labs):
             print(f"        {note}")
 
 
-def check_demo(checks, out, labs, student_fallback=True):
+def check_demo(checks, out, labs):
     shutil.rmtree(out, ignore_errors=True)
     try:
-        run_demos(out, echo=False, labs=labs, student_fallback=student_fallback)
+        run_demos(out, echo=False, labs=labs, quick=True)
     except CourseError as error:
         checks.record(False, f"demo: {error}", error.details)
         return
@@ -296,10 +308,10 @@ MISTAKES_WHOLE = 2
 
 def check_mistakes(checks, labs):
     with_catalogue = [lab for lab in labs if catalogue(lab)]
-    whole, first = with_catalogue[-MISTAKES_WHOLE:], with_catalogue[:-MISTAKES_WHOLE]
+    whole = with_catalogue[-MISTAKES_WHOLE:]
     try:
-        results = {**run_mistakes(first, limit=1, log=lambda _line: None),
-                   **run_mistakes(whole, log=lambda _line: None)}
+        results = run_mistakes(with_catalogue, limit={lab: None if lab in whole else 1 for lab in with_catalogue},
+                               log=lambda _line: None)
     except CourseError as error:
         checks.record(False, f"mistakes: {error}", error.details)
         return
@@ -342,6 +354,12 @@ def cmd_test(argv):
         checks.record(False, str(error), error.details)
         return checks.finish()
     check_house_limits(checks)
+    # The sanitizer build compiles, then runs the suite, in the background,
+    # niced, from the start: niced, it takes what the foreground leaves (the
+    # main build's links and its last files, the checks that run one process
+    # at a time), and it is paused while the fuzzers run (they want a core
+    # each). Its results are waited for last.
+    sanitizing = None if is_release() else start_sanitize(checks)
     labs = build_labs(checks, lab_dirs())
     check_ctest(checks)
     out = BUILD / "test-demo"
@@ -351,7 +369,7 @@ def cmd_test(argv):
             report_student_score(labs)
         with_reference = [lab for lab in labs if manifest()[lab]["reference"]]
         with checks.timed("demo"):
-            check_demo(checks, out, with_reference, student_fallback=False)
+            check_demo(checks, out, with_reference)
         with checks.timed("rejects"):
             check_rejects(checks, with_reference)
     else:
@@ -365,13 +383,8 @@ def cmd_test(argv):
         # (the two cores share caches).
         fuzzing = check_fuzz(checks)
         if fuzzing:
-            fuzzing()
-        # The sanitizer build compiles, then runs the suite, in the background,
-        # niced, beside every check after the fuzzer's (which runs alone,
-        # above): those leave a core or part of one free most of the time,
-        # the student loop's and the autograder's builds too. Its results
-        # are waited for last.
-        sanitizing = start_sanitize(checks)
+            with sanitizing.paused() if sanitizing else nullcontext():
+                fuzzing()
         with checks.timed("honesty: the solutions graded"):
             check_solutions(checks, labs)
         with checks.timed("honesty: the stubs graded"):

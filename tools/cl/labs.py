@@ -82,9 +82,40 @@ def _demo_text_lines(lab):
     return [line for line in lines if line and not line.startswith("#")]
 
 
-def demo_lines(lab):
-    """The argument lists in labs/LAB/demo.txt (its runs; not its `view:` lines)."""
-    return [shlex.split(line) for line in _demo_text_lines(lab) if not line.startswith(VIEW_PREFIX)]
+QUICK_MARK = " # quick:"
+
+
+def quick_args(args, overrides):
+    """ARGS with each `--flag value` of OVERRIDES put in place of the flag's
+    value there (appended where ARGS lacks the flag)."""
+    args = list(args)
+    for flag, value in zip(overrides[::2], overrides[1::2]):
+        if flag in args[:-1]:
+            args[args.index(flag) + 1] = value
+        else:
+            args += [flag, value]
+    return args
+
+
+def demo_lines(lab, quick=False):
+    """The argument lists in labs/LAB/demo.txt (its runs; not its `view:` lines).
+    A run may end with `# quick: --flag value ...`: with `quick` (./course test,
+    ./course demo --quick) those values replace the run's, a shorter run that
+    still writes every file the figures and views read."""
+    runs = []
+    for line in _demo_text_lines(lab):
+        if line.startswith(VIEW_PREFIX):
+            continue
+        full, mark, overrides = line.partition(QUICK_MARK)
+        args = shlex.split(full)
+        if mark:
+            overrides = shlex.split(overrides)
+            if len(overrides) % 2 or not all(flag.startswith("--") for flag in overrides[::2]):
+                raise CourseError(f"labs/{lab}/demo.txt: `# quick:` takes `--flag value` pairs: {line}")
+            if quick:
+                args = quick_args(args, overrides)
+        runs.append(args)
+    return runs
 
 
 def view_lines(lab):

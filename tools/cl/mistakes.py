@@ -19,6 +19,7 @@ import re
 import subprocess
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from . import grade
@@ -71,13 +72,18 @@ def tree_env():
     return dict(os.environ, CCACHE_BASEDIR=str(ROOT))
 
 
-def build(targets):
+def configure_tree():
     build_dir = TREE / "build"
     if not (build_dir / "CMakeCache.txt").is_file():
         done = subprocess.run(["cmake", "-S", str(TREE), "-B", str(build_dir), "-G", "Ninja",
                                "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True, env=tree_env())
         if done.returncode != 0:
             raise CourseError("mistakes: the scratch tree does not configure", details=done.stdout.splitlines()[-10:])
+
+
+def build(targets):
+    build_dir = TREE / "build"
+    configure_tree()
     done = subprocess.run(["cmake", "--build", str(build_dir), "--target", *targets, "-j", "2"],
                           capture_output=True, text=True, env=tree_env())
     errors = [line for line in done.stdout.splitlines() if "error" in line][:6]
@@ -100,7 +106,7 @@ def check_symptom(lab, symptom):
     """None when the planted build's run shows the symptom; else what it showed."""
     with tempfile.TemporaryDirectory(prefix="cl-symptom-") as scratch:
         scratch = Path(scratch)
-        output, code, _ = run_command(symptom["command"], False, scratch, CASE_TIMEOUT, bin_dir=TREE / "build" / "bin")
+        output, code, _ = run_command(symptom["command"], True, scratch, CASE_TIMEOUT, bin_dir=TREE / "build" / "bin")
         try:
             value = read_value(symptom["read"], output, scratch)
         except (LookupError, OSError, ValueError, KeyError, IndexError) as error:
@@ -117,32 +123,74 @@ def check_symptom(lab, symptom):
     return None
 
 
-def references_of(lab):
-    """The lab's reference files, written as its student files in the tree."""
-    references = {p.name: p.read_text() for p in (ROOT / "solutions" / lab).glob("*.cpp")}
-    for name, text in references.items():
-        write_if_changed(TREE / "labs" / lab / name, text)
-    return references
+def planted_path(lab, entry):
+    """Where an entry is planted: the tree's reference file of it. The tree's
+    programs are the `_solution` ones, whose every object but the planted file's
+    is the main build's (the same source at the same relative path: ccache hits)."""
+    return TREE / "solutions" / lab / entry["file"]
 
 
-def plant(lab, entry, references):
-    """Write the entry's mistake into the tree's student file; None, or why it cannot be planted."""
-    reference = references.get(entry["file"])
-    if reference is None:
+def plant(lab, entry):
+    """Write the entry's mistake into the tree's reference file; None, or why it cannot be planted."""
+    source = ROOT / "solutions" / lab / entry["file"]
+    if not source.is_file():
         return f"solutions/{lab}/{entry['file']}: no such reference file"
+    reference = source.read_text()
     if reference.count(entry["find"]) != 1:
         return f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
-    write_if_changed(TREE / "labs" / lab / entry["file"], reference.replace(entry["find"], entry["replace"]))
+    write_if_changed(planted_path(lab, entry), reference.replace(entry["find"], entry["replace"]))
     return None
 
 
+def unplant(lab, entry):
+    source = ROOT / "solutions" / lab / entry["file"]
+    if source.is_file():
+        write_if_changed(planted_path(lab, entry), source.read_text())
+
+
 def targets_of(lab, entry):
-    return [f"{lab}_tests", *([lab] if entry.get("symptom") else [])]
+    return [f"{lab}_tests_solution", *([f"{lab}_solution"] if entry.get("symptom") else [])]
+
+
+def reference_sources(targets):
+    """{target: the reference files (solutions/LAB/FILE) compiled into it}, from Ninja's commands."""
+    build_dir = TREE / "build"
+    found = {}
+    for target in targets:
+        done = subprocess.run(["ninja", "-C", str(build_dir), "-t", "commands", target],
+                              capture_output=True, text=True, check=False)
+        found[target] = set(re.findall(r"solutions/(lab\d\d_\w+?/\w+\.cpp)\b", done.stdout))
+    return found
+
+
+def schedule(planned):
+    """Rounds of (lab, entry): one entry of each of several labs, planted at once
+    and built in one go, where no planted file is compiled into another plant's
+    programs (a lab's tests and executable link earlier labs' references: lab 14's
+    contain lab 08's). Each entry goes in the first round that can take it: the
+    first entries of every lab (the longest catalogue first), then the second..."""
+    configure_tree()  # so that Ninja can list what each target compiles
+    longest = sorted(planned, key=lambda lab: -len(planned[lab]))
+    wanted = [(lab, planned[lab][k]) for k in range(max(map(len, planned.values()), default=0))
+              for lab in longest if k < len(planned[lab])]
+    sources = reference_sources({t for lab, entry in wanted for t in targets_of(lab, entry)})
+    rounds = []
+    for lab, entry in wanted:
+        mine = f"{lab}/{entry['file']}"
+        uses = set().union(*(sources[t] for t in targets_of(lab, entry)))
+        for taken in rounds:
+            if all(other != lab and mine not in used and f"{other}/{planted['file']}" not in uses
+                   for other, planted, used in taken):
+                taken.append((lab, entry, uses))
+                break
+        else:
+            rounds.append([(lab, entry, uses)])
+    return [[(lab, entry) for lab, entry, _ in taken] for taken in rounds]
 
 
 def judge(lab, entry, every_case, lines):
     """None when the built tree catches the planted entry (and shows its symptom); else the problem."""
-    program = TREE / "build" / "bin" / f"{lab}_tests"
+    program = TREE / "build" / "bin" / f"{lab}_tests_solution"
     passing = [name for name in entry["fails"] if not case_fails(program, name)]
     if passing:
         return "not caught: " + "; ".join(f'"{name}" passes' for name in passing)
@@ -165,55 +213,28 @@ def record(entry, problem, seconds, lines, log):
     return 1
 
 
-def restore(lab):
-    for source in (ROOT / "labs" / lab).glob("*.cpp"):
-        write_if_changed(TREE / "labs" / lab / source.name, source.read_text())
-
-
-def plant_all(lab, entries, every_case, log):
-    """(caught, lines) for one lab's entries, planted one at a time."""
-    references = references_of(lab)
-    caught, lines = 0, []
-    for entry in entries:
-        start = time.monotonic()
-        problem = plant(lab, entry, references)
-        if problem is None:
-            built, errors = build(targets_of(lab, entry))
-            problem = judge(lab, entry, every_case, lines) if built else \
-                "the planted file does not build: " + " | ".join(errors)
-            write_if_changed(TREE / "labs" / lab / entry["file"], references[entry["file"]])
-        caught += record(entry, problem, time.monotonic() - start, lines, log)
-    restore(lab)
-    return caught, lines
-
-
-def plant_first_entries(labs, log):
-    """{lab: (caught, 1, lines)}: the first entry of each lab planted at once and
-    built in one go. A lab's tests link the earlier labs' references, never
-    their student files, so the mistakes of different labs cannot meet."""
-    planted, results = {}, {}
-    for lab in labs:
-        entries = catalogue(lab)
-        if entries:
-            references = references_of(lab)
-            planted[lab] = (entries[0], plant(lab, entries[0], references), entries)
-    targets = [t for lab, (entry, problem, _) in planted.items() if problem is None for t in targets_of(lab, entry)]
+def plant_round(plants, every_case, log, lines):
+    """Plant one round's entries at once, build them in one go (Ninja shares
+    the two cores among the labs' files), judge them two at a time, and put the
+    references back; {lab: 1 when caught, else 0}."""
     start = time.monotonic()
-    built, errors = build(targets) if targets else (True, [])
-    if not built:  # which lab's plant breaks the build: each on its own
-        built_alone = {lab: build(targets_of(lab, entry))[0] for lab, (entry, problem, _) in planted.items()
-                       if problem is None}
-    for lab, (entry, problem, entries) in planted.items():
-        lines = []
-        if problem is None:
-            if built or built_alone.get(lab):
-                problem = judge(lab, entry, False, lines)
-            else:
-                problem = "the planted file does not build: " + " | ".join(errors)
-        caught = record(entry, problem, time.monotonic() - start, lines, log)
-        results[lab] = (caught, 1, lines + troubleshooting_gaps(lab, entries))
-        restore(lab)
-    return results
+    problems = {lab: plant(lab, entry) for lab, entry in plants}
+    ready = [(lab, entry) for lab, entry in plants if problems[lab] is None]
+    built, errors = build([t for lab, entry in ready for t in targets_of(lab, entry)]) if ready else (True, [])
+    if not built:  # which plant breaks the build: each on its own
+        alone = {lab: build(targets_of(lab, entry)) for lab, entry in ready}
+    judged = [(lab, entry) for lab, entry in ready if built or alone[lab][0]]
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        verdicts = dict(zip((lab for lab, _ in judged),
+                            pool.map(lambda plant: judge(*plant, every_case, lines[plant[0]]), judged)))
+    caught = {}
+    for lab, entry in plants:
+        problem = problems[lab] or verdicts.get(lab)
+        if problem is None and lab not in verdicts:
+            problem = "the planted file does not build: " + " | ".join(alone[lab][1])
+        caught[lab] = record(entry, problem, time.monotonic() - start, lines[lab], log)
+        unplant(lab, entry)
+    return caught
 
 
 def troubleshooting_gaps(lab, entries):
@@ -233,20 +254,21 @@ def troubleshooting_gaps(lab, entries):
 
 
 def run_mistakes(labs, limit=None, every_case=False, log=print):
-    """{lab: (caught, planted, lines)}; `limit` plants at most that many entries of a lab
-    (limit=1: the first entry of every lab at once, one build)."""
+    """{lab: (caught, planted, lines)}; `limit` plants at most that many entries of
+    a lab (an int, or {lab: int or None}). The entries are planted in rounds
+    (schedule): one entry of each of several labs at once."""
     sync_tree()
-    if limit == 1 and not every_case:
-        return plant_first_entries(labs, log)
-    results = {}
-    for lab in labs:
-        entries = catalogue(lab)
-        if not entries:
-            continue
-        planted = entries[:limit] if limit else entries
-        caught, lines = plant_all(lab, planted, every_case, log)
-        results[lab] = (caught, len(planted), lines + troubleshooting_gaps(lab, entries))
-    return results
+    limits = limit if isinstance(limit, dict) else {lab: limit for lab in labs}
+    catalogues = {lab: catalogue(lab) for lab in labs}
+    planned = {lab: entries[:limits.get(lab)] if limits.get(lab) else entries
+               for lab, entries in catalogues.items() if entries}
+    caught = {lab: 0 for lab in planned}
+    lines = {lab: [] for lab in planned}
+    for plants in schedule(planned):
+        for lab, got in plant_round(plants, every_case, log, lines).items():
+            caught[lab] += got
+    return {lab: (caught[lab], len(entries), lines[lab] + troubleshooting_gaps(lab, catalogues[lab]))
+            for lab, entries in planned.items()}
 
 
 def cmd_mistakes(argv):

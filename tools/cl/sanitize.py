@@ -4,6 +4,7 @@ check_hostile), whose server must stay clean too."""
 import argparse
 import atexit
 from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 import os
 import signal
 import subprocess
@@ -20,6 +21,27 @@ from .labs import manifest
 
 SANITIZE_BUILD = BUILD / "asan"
 SANITIZE_FLAGS = "-Og -g1"  # with CL_SANITIZE's -fsanitize=address,undefined (CMakeLists.txt)
+
+# The CPU seconds of the background's processes, each reaped by os.wait4, so
+# that ./course test's table can count them apart from the foreground steps'.
+_background = {"cpu": 0.0}
+_background_lock = threading.Lock()
+
+
+def background_cpu():
+    """CPU seconds (user + system) of the background suite's finished processes."""
+    with _background_lock:
+        return _background["cpu"]
+
+
+def wait_counted(process):
+    """Wait for `process` (a Popen) with os.wait4 and count its CPU, and its
+    children's, as the background's; return its exit code."""
+    _, status, usage = os.wait4(process.pid, 0)
+    process.returncode = os.waitstatus_to_exitcode(status)
+    with _background_lock:
+        _background["cpu"] += usage.ru_utime + usage.ru_stime
+    return process.returncode
 
 
 SANITIZE_LIVE = "lab04_pbd_solution"  # the live server's attacks run on it (check_hostile)
@@ -64,13 +86,18 @@ def build_sanitized(log=sys.stdout):
 class BackgroundSuite:
     """The sanitizer build's compile and then its runs, started now and waited
     for at the end (./course test runs them beside its other checks). Niced,
-    so that those checks keep the cores they use; stopped if ./course test
+    so that those checks keep the cores they use; paused (SIGSTOP) while a
+    check needs the cores to itself (the fuzzers); stopped if ./course test
     ends first."""
 
     def __init__(self):
+        self.gate = threading.Event()  # set: the background may run
+        self.gate.set()
+        self.lock = threading.Lock()
+        self.running = set()  # the sanitizer-built programs running now
         self.targets = configure_sanitized(log=None)
-        self.build_seconds = None
-        self.run_seconds = None
+        self.build_seconds = self.build_cpu = None
+        self.run_seconds = self.run_cpu = None
         self.results = None
         self.error = None
         self.output = tempfile.TemporaryFile(mode="w+")
@@ -84,22 +111,61 @@ class BackgroundSuite:
 
     def work(self):
         try:
-            code = self.process.wait()
+            code = wait_counted(self.process)
             self.build_seconds = time.monotonic() - self.started
+            self.build_cpu = background_cpu()
             self.output.seek(0)
             text = self.output.read()
             self.output.close()
             if code != 0:
                 raise BuildFailure(self.targets, first_errors(text))
             start = time.monotonic()
-            self.results = run_programs(self.targets, nice=True) + [run_live(nice=True)]
+            self.results = run_programs(self.targets, nice=True, suite=self) + [run_live(nice=True)]
             self.run_seconds = time.monotonic() - start
+            self.run_cpu = background_cpu() - self.build_cpu
         except BaseException as error:  # handed to finish(), in the main thread
             self.error = error
 
     def stop(self):
-        if self.process.poll() is None:
+        if self.process.returncode is None:
             os.killpg(self.process.pid, signal.SIGTERM)
+
+    def send(self, number):
+        """Send `number` to the build (its whole process group) or to the programs running."""
+        if self.process.returncode is None:
+            try:
+                os.killpg(self.process.pid, number)
+            except ProcessLookupError:
+                pass
+        for process in self.running:
+            try:
+                os.kill(process.pid, number)
+            except ProcessLookupError:
+                pass
+
+    @contextmanager
+    def paused(self):
+        """Stop the background for the duration (SIGSTOP, then SIGCONT); no
+        program of it starts meanwhile."""
+        with self.lock:
+            self.gate.clear()
+            self.send(signal.SIGSTOP)
+        try:
+            yield
+        finally:
+            with self.lock:
+                self.send(signal.SIGCONT)
+                self.gate.set()
+
+    def start(self, command, **options):
+        """Popen(command) once the background may run, counted among those running."""
+        while True:
+            self.gate.wait()
+            with self.lock:
+                if self.gate.is_set():
+                    process = subprocess.Popen(command, **options)
+                    self.running.add(process)
+                    return process
 
     def finish(self):
         """Wait for the build and the runs; return [(program, ok, summary line,
@@ -110,26 +176,35 @@ class BackgroundSuite:
         return self.results
 
 
-def run_programs(targets, nice=False):
+def run_programs(targets, nice=False, suite=None):
     """Run each sanitizer-built test program, every case: [(program, ok, summary line, report lines)],
-    two programs at a time (each runs on one core), niced when `nice`."""
+    two programs at a time (each runs on one core), niced when `nice`, in `suite`
+    (a BackgroundSuite) when given."""
     with ThreadPoolExecutor(max_workers=2) as pool:
-        return list(pool.map(lambda name: run_program(name, nice), targets))
+        return list(pool.map(lambda name: run_program(name, nice, suite), targets))
 
 
-def run_program(name, nice=False):
+def run_program(name, nice=False, suite=None):
     """Run one sanitizer-built test program: (program, ok, summary line, report lines)."""
     env = sanitizer_env(leaks=True)
     start = time.monotonic()
     command = [*(["nice", "-n", "10"] if nice else []), str(SANITIZE_BUILD / "bin" / name)]
-    with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
-        done = subprocess.run(command, cwd=work, env=env, capture_output=True, text=True, check=False)
-    output = done.stdout + done.stderr
+    with tempfile.TemporaryDirectory(prefix="cl-asan-") as work, tempfile.TemporaryFile(mode="w+") as log:
+        options = dict(cwd=work, env=env, stdout=log, stderr=subprocess.STDOUT, text=True)
+        if suite is None:
+            code = subprocess.Popen(command, **options).wait()
+        else:
+            process = suite.start(command, **options)
+            code = wait_counted(process)
+            with suite.lock:
+                suite.running.discard(process)
+        log.seek(0)
+        output = log.read()
     report = grade.sanitizer_report(output, ROOT)
-    ok = done.returncode == 0 and not report
+    ok = code == 0 and not report
     lines = output.splitlines()
     summary = next((line for line in reversed(lines) if "test cases" in line or "All tests passed" in line),
-                   f"exit code {done.returncode}")
+                   f"exit code {code}")
     return (name, ok, f"{summary.strip()} ({time.monotonic() - start:.1f} s)",
             report or ([] if ok else lines[-20:]))
 
@@ -187,9 +262,9 @@ def check_sanitize(checks, background):
                 results = background.finish()
             finally:
                 checks.add_time("sanitize: build (in the background, niced)", background.build_seconds or 0.0,
-                                concurrent=True)
+                                concurrent=True, cpu=background.build_cpu)
                 checks.add_time("sanitize: runs (in the background, niced)", background.run_seconds or 0.0,
-                                concurrent=True)
+                                concurrent=True, cpu=background.run_cpu)
     except BuildFailure as error:
         checks.record(False, f"sanitizer build: {error}", error.lines)
         return

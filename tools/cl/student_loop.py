@@ -96,6 +96,10 @@ def check_student_loop(checks):
         checks.record(ok, f"release lab03, lab 01 writes past an unsized matrix: grade names {where}",
                       [] if ok else lines)
 
+        # 4. ./course demo in the week's release: the labs with a reference run,
+        # the others are named in one line as skipped (never a stub's exit 3).
+        check_release_demo(checks, tree, lab3)
+
         # The same tree and build, a later week: its executables and hints.
         for lab in (lab1, lab3, lab4):
             for source in (ROOT / "solutions" / lab).glob("*.cpp"):
@@ -148,3 +152,18 @@ def check_later_week(checks, tree, ids, week="lab08"):
     missing = sorted({line.strip() for line in said for m in TARGET.finditer(line) if m[1] not in present})
     checks.record(not missing, f"release {week}: no printed hint names a reference that is not shipped "
                   f"(./course plots -v, help, run)", missing[:10])
+
+
+def check_release_demo(checks, tree, week):
+    """./course demo in TREE, the release of `week`: exit 0, the labs with a
+    reference shipped ran (their folders in out/), and one line names the
+    skipped ones, the week's lab first."""
+    code, lines = sub_course(tree, "demo")
+    shipped = sorted(p.name for p in (tree / "solutions").iterdir() if p.is_dir())
+    ran = [lab for lab in shipped if (tree / "out" / lab).is_dir()]
+    said = [line for line in lines if "demo skipped for" in line]
+    ok = (code == 0 and ran == shipped and len(said) == 1
+          and said[0].strip().startswith(f"demo skipped for {grade.lab_id(week)},"))
+    checks.record(ok, f"release {grade.lab_id(week)}: ./course demo exits {code}, runs "
+                  f"{', '.join(grade.lab_id(lab) for lab in ran) or 'nothing'}, "
+                  f"and names the skipped labs in one line", [] if ok else lines[-12:])
