@@ -22,6 +22,7 @@
 // inside xpbd_step), so its figure carries 1/20 of a step's own work
 // (prediction, α̃ per spring, the checks).
 #include <omp.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -222,9 +223,12 @@ void BM_XpbdStepCalling(benchmark::State& state) { xpbd<true>(state); }
 #endif
 
 // Remembers each run's CPU time per iteration for the summary: the median
-// aggregate when the runs were repeated, else the median of the runs.
+// aggregate when the runs were repeated, else the median of the runs. It
+// prints as the library's own reporter does: in colour on a terminal only, so
+// that a pipe reads plain `BM_` lines (./course test counts them).
 class Collector : public benchmark::ConsoleReporter {
  public:
+  Collector() : ConsoleReporter(isatty(STDOUT_FILENO) ? OO_Defaults : OO_Tabular) {}
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
