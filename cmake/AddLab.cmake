@@ -117,7 +117,7 @@ function(add_lab name)
     # compile as one batch that parses their headers once (lab 05's three: 7.0 s
     # of CPU, not 9.8 s); elsewhere file by file, as written.
     if(CL_SANITIZE)
-      set_target_properties(${name}_support PROPERTIES UNITY_BUILD ON UNITY_BUILD_BATCH_SIZE 0)
+      cl_unity(${name}_support 0)
     endif()
   else()
     add_library(${name}_support INTERFACE)
@@ -206,8 +206,8 @@ function(add_lab name)
   # else links as in NAME_tests, uninstrumented, so only a few files compile.
   add_executable(${name}_tests_asan EXCLUDE_FROM_ALL ${test_sources} ${student_sources})
   # The tests in batches as in NAME_tests; the student's files as written.
-  cl_unity_tests(${name}_tests_asan)
   set_source_files_properties(${student_sources} PROPERTIES SKIP_UNITY_BUILD_INCLUSION ON)
+  cl_unity_tests(${name}_tests_asan)
   target_link_libraries(${name}_tests_asan PRIVATE catch_main ${name}_support)
   list(LENGTH isolated_chain chain_length)
   if(chain_length GREATER 2)
