@@ -56,7 +56,7 @@ usage: ./course COMMAND [ARGS]
   mistakes [labNN ...] [--all-cases] the catalogued student mistakes (solutions/*/mistakes.json),
                                      each planted: the grader must catch it (instructor)
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
-  sanitize                           the whole test suite under AddressSanitizer and UBSan (build/asan)
+  sanitize                           the whole test suite under AddressSanitizer and UBSan (build-asan)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""

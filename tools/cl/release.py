@@ -20,7 +20,7 @@ from .labs import lab_dirs, resolve_lab
 
 RELEASE_MARKER = "release.json"
 HIDDEN_TESTS = re.compile(r"^tests/[^/]+/hidden_[^/]*\.cpp$")  # never in a release (cl/autograder.py)
-SKIPPED_DIRS = {".git", "build", "out", "__pycache__"}
+SKIPPED_DIRS = {".git", "build", "build-asan", "out", "__pycache__"}
 
 
 def is_release():

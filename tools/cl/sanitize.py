@@ -1,4 +1,4 @@
-"""./course sanitize: the whole test suite under ASan and UBSan (build/asan), and its CI check;
+"""./course sanitize: the whole test suite under ASan and UBSan (build-asan), and its CI check;
 then lab 04's reference in live mode under the round-3 attacks (tools/cl/live_hostile.py:
 check_hostile), whose server must stay clean too."""
 import argparse
@@ -6,6 +6,7 @@ import atexit
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 import os
+import shlex
 import signal
 import subprocess
 import sys
@@ -19,8 +20,11 @@ from .build import (BuildFailure, build_command, build_targets, configure, first
                     sanitizer_env)
 from .labs import manifest
 
-SANITIZE_BUILD = BUILD / "asan"
-SANITIZE_FLAGS = "-Og -g1"  # with CL_SANITIZE's -fsanitize=address,undefined (CMakeLists.txt)
+# Beside BUILD, not inside it: at the same depth under the course's root, its
+# compile lines are the main build's once ccache makes paths relative to the
+# root (./course test), so the test programs' own files, compiled alike in both
+# (CMakeLists.txt: CL_SANITIZE), are compiled once.
+SANITIZE_BUILD = BUILD.parent / f"{BUILD.name}-asan"
 
 # The CPU seconds of the background's processes, each reaped by os.wait4, so
 # that ./course test's table can count them apart from the foreground steps'.
@@ -55,7 +59,7 @@ def sanitize_targets():
 
 def run_sanitized(log=sys.stdout):
     """Build the test suite with -fsanitize=address,undefined (CMakeLists.txt: CL_SANITIZE)
-    into BUILD/asan and run every test program there, every case (hidden ones too).
+    into SANITIZE_BUILD and run every test program there, every case (hidden ones too).
     Return [(program, ok, summary line, report lines)], the live attacks last."""
     return run_programs(build_sanitized(log)) + [run_live()]
 
@@ -63,14 +67,15 @@ def run_sanitized(log=sys.stdout):
 def configure_sanitized(log=sys.stdout):
     """Configure the sanitizer build (when new or its flags changed); return its test programs' names."""
     configure(log=log)  # labs.json says which labs have a reference
-    # -Og: GCC's level for debugging, which keeps every line and compiles a
-    # third faster than -O1 under the sanitizers (a lab 06 test batch: 16.6 s
-    # of CPU against 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
+    # A Release build whose course code CMakeLists.txt compiles at -Og -g1
+    # (GCC's level for debugging, which keeps every line and compiles a third
+    # faster than -O1 under the sanitizers: a lab 06 batch, 16.6 s of CPU
+    # against 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
     cache = SANITIZE_BUILD / "CMakeCache.txt"
-    if not cache.is_file() or f"CMAKE_CXX_FLAGS_RELWITHDEBINFO:STRING={SANITIZE_FLAGS}" not in cache.read_text():
+    text = cache.read_text() if cache.is_file() else ""
+    if "CL_SANITIZE:BOOL=ON" not in text or "CMAKE_BUILD_TYPE:STRING=Release" not in text:
         quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), *generator_args(SANITIZE_BUILD),
-               "-DCL_SANITIZE=ON",
-               "-DCMAKE_BUILD_TYPE=RelWithDebInfo", f"-DCMAKE_CXX_FLAGS_RELWITHDEBINFO={SANITIZE_FLAGS}"],
+               "-DCL_SANITIZE=ON", "-DCMAKE_BUILD_TYPE=Release"],
               "configure the sanitizer build")
     return sanitize_targets()
 
@@ -102,8 +107,15 @@ class BackgroundSuite:
         self.error = None
         self.output = tempfile.TemporaryFile(mode="w+")
         self.started = time.monotonic()
+        # The instrumented libraries first, the test programs after: their own
+        # files are the main build's (CMakeLists.txt: CL_SANITIZE), which by
+        # then has compiled them for ccache to hand over, where a test batch
+        # reached first would be compiled twice.
+        libraries = ["common", *(f"{lab}_reference" for lab, entry in manifest().items() if entry["reference"])]
+        phases = [build_command(libraries, SANITIZE_BUILD),
+                  build_command([*self.targets, SANITIZE_LIVE], SANITIZE_BUILD)]
         self.process = subprocess.Popen(
-            ["nice", "-n", "10", *build_command([*self.targets, SANITIZE_LIVE], SANITIZE_BUILD)],
+            ["nice", "-n", "10", "sh", "-c", " && ".join(shlex.join(phase) for phase in phases)],
             cwd=ROOT, stdout=self.output, stderr=subprocess.STDOUT, text=True, start_new_session=True)
         atexit.register(self.stop)
         self.thread = threading.Thread(target=self.work, daemon=True)
