@@ -360,7 +360,11 @@ def cmd_test(argv):
     # at a time), and it is paused while the fuzzers run (they want a core
     # each). Its results are waited for last.
     sanitizing = None if is_release() else start_sanitize(checks)
-    labs = build_labs(checks, lab_dirs())
+    try:
+        labs = build_labs(checks, lab_dirs())
+    finally:
+        if sanitizing is not None:
+            sanitizing.main_built.set()  # its test programs' files are now in ccache
     check_ctest(checks)
     out = BUILD / "test-demo"
     if is_release():
