@@ -125,14 +125,21 @@ struct MapCell {
 };
 
 // "stable" (the unlimited run is healthy), "bounded by the limiter" (it blew
-// up, the limited run did not and, for springs, kept the band), or "blew up"
+// up, the limited run did not, kept the band (springs) and any rise of its
+// energy within what the scene can release inside the band), or "blew up"
 // (the limited run went wrong too: reported unstable, or finite but outside
-// the band); `why` says what went wrong last.
+// the band or past that energy); `why` says what went wrong last.
 std::string cell_verdict(const MapCell& cell, Limit limit, const LabOptions& lab, int iterations,
                          std::string& why) {
   why.clear();
   if (cell.unlimited.problem.empty()) return "stable";
   why = cell.limited.problem.empty() ? band_problem(cell.limited, limit, lab, iterations) : cell.limited.problem;
+  if (why.empty() && cell.limited.energy_exceeded_step >= 0 && !energy_contained(cell.limited, true)) {
+    char text[160];
+    std::snprintf(text, sizeof text, "energy not contained: it rose %.3g J, beyond the %.3g J the scene can release "
+                  "inside the band", cell.limited.max_energy_rise, cell.limited.energy_bound);
+    why = text;
+  }
   if (why.empty()) {
     why = "unlimited: " + cell.unlimited.problem;
     return "bounded by the limiter";
@@ -196,19 +203,21 @@ int stability_map(const char* lab_name, const std::string& scene_dir, const Comm
   cl::CsvTable table({"scene", "limit", "iterations", "sigma_min", "sigma_max", "stiffness", "dt",
                       "dt_explicit_estimate", "steps", "verdict", "unlimited_steps_done", "unlimited_max_strain", "unlimited_status",
                       "limited_steps_done", "limited_max_strain", "limited_min_strain", "limited_max_energy_rise",
-                      "limited_status", "why", "seconds"});
+                      "limited_energy_bound", "limited_status", "why", "seconds"});
   std::printf("%s: scene %s, limit %s, band [%.4g, %.4g], K = %d, %.3g s per cell\n", lab_name,
               cl::describe(scene).c_str(), limit_name(limit), lab.sigma_min, lab.sigma_max,
               options.iterations, lab.map_seconds);
   std::printf("%10s %10s %7s  %-24s %14s  %s\n", "k (N/m)", "dt (s)", "steps", "verdict", "limited max", "why");
-  int stable = 0, bounded = 0, blew_up = 0, band_lost = 0;
+  int stable = 0, bounded = 0, blew_up = 0, band_lost = 0, energy_lost = 0;
   for (const MapCell& cell : cells) {
     std::string why;
     const std::string verdict = cell_verdict(cell, limit, lab, options.iterations, why);
     stable += verdict == "stable";
     bounded += verdict == "bounded by the limiter";
     blew_up += verdict == "blew up";
-    band_lost += verdict == "blew up" && cell.limited.problem.empty();
+    const bool finite = verdict == "blew up" && cell.limited.problem.empty();
+    energy_lost += finite && why.rfind("energy not contained", 0) == 0;
+    band_lost += finite && why.rfind("energy not contained", 0) != 0;
     table.add_row({scene.name, limit_name(limit), static_cast<long long>(options.iterations),
                    lab.sigma_min, lab.sigma_max, cell.stiffness, cell.dt,
                    2.0 / std::sqrt(8.0 * cell.stiffness * largest_inv_mass), static_cast<long long>(cell.steps),
@@ -219,6 +228,7 @@ int stability_map(const char* lab_name, const std::string& scene_dir, const Comm
                    cl::cell_if(cell.limited_run, cell.limited.max_strain),
                    cl::cell_if(cell.limited_run, cell.limited.min_strain),
                    cl::cell_if(cell.limited_run, cell.limited.max_energy_rise),
+                   cl::cell_if(cell.limited_run, cell.limited.energy_bound),
                    cell.limited_run ? cl::CsvCell{status_of(cell.limited)} : cl::CsvCell{std::string()}, why,
                    cell.unlimited.seconds + cell.limited.seconds});
     char limited_max[32] = "";
@@ -228,8 +238,10 @@ int stability_map(const char* lab_name, const std::string& scene_dir, const Comm
     std::printf("%10.3g %10.3g %7d  %-24s %14s  %s\n", cell.stiffness, cell.dt, cell.steps, verdict.c_str(),
                 limited_max, why.c_str());
   }
-  std::printf("  %d stable, %d bounded by the limiter, %d blew up (%d of them finite but outside the band), of %zu\n",
-              stable, bounded, blew_up, band_lost, cells.size());
+  std::printf("  %d stable, %d bounded by the limiter, %d blew up (%d of them finite but outside the band", stable,
+              bounded, blew_up, band_lost);
+  if (energy_lost > 0) std::printf(", %d inside it but past the energy it allows", energy_lost);
+  std::printf("), of %zu\n", cells.size());
   if (!options.out.empty()) table.write(cl::join_path(options.out, "stability_map.csv"));
   return 0;
 }

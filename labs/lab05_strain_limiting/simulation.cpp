@@ -174,11 +174,30 @@ double elastic_energy(const Eigen::Matrix3Xd& x, const std::vector<Spring>& spri
   return energy;
 }
 
+double band_energy(const std::vector<Spring>& springs, double sigma_min, double sigma_max) {
+  const double reach = std::max(sigma_max - 1.0, 1.0 - sigma_min);
+  double energy = 0.0;
+  for (const Spring& spring : springs) {
+    const double stretch = reach * spring.rest_length;
+    energy += 0.5 * spring.stiffness * stretch * stretch;
+  }
+  return energy;
+}
+
+bool energy_contained(const RunResult& result, bool band_held) {
+  return result.problem.empty() && result.energy_exceeded_step >= 0 && band_held &&
+         result.max_energy_rise <= result.energy_bound;
+}
+
 RunResult run_steps(Particles& particles, const LimitedSystem& system, const StepSettings& settings, int steps,
                     bool check_energy, const StepCallback& on_step, const FrameOutput& output) {
   if (steps < 0) throw std::invalid_argument("run_steps: steps must be >= 0 (got " + std::to_string(steps) + ")");
   RunResult result;
   result.energy_scale = energy_scale(particles, settings.gravity, settings.dt);
+  result.energy_bound = result.energy_scale;
+  if (settings.limit != Limit::kNone && settings.iterations > 0) {
+    result.energy_bound += band_energy(system.springs, settings.sigma_min, settings.sigma_max);
+  }
   FramePlan loop = frame_plan(steps, settings.dt, result.energy_scale);
   loop.energy_verdict = check_energy ? EnergyVerdict::kStop : EnergyVerdict::kReport;
 

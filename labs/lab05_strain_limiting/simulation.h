@@ -81,6 +81,10 @@ SignedStrain signed_strain(const Eigen::Matrix3Xd& x, const std::vector<Spring>&
 // Σ ½ k (‖x_i − x_j‖ − L)² over the springs, J.
 double elastic_energy(const Eigen::Matrix3Xd& x, const std::vector<Spring>& springs);
 
+// Σ ½ k (L · max(σ_max − 1, 1 − σ_min))² over the springs, J: the most elastic
+// energy the springs hold with every one of them inside the band [σ_min, σ_max].
+double band_energy(const std::vector<Spring>& springs, double sigma_min, double sigma_max);
+
 // What one step looked like after it was taken (step 0: the initial state).
 struct StepRecord {
   int step = 0;
@@ -104,17 +108,29 @@ struct RunResult {
   double energy_end = 0.0;
   double max_energy_rise = 0.0;   // max over steps of E(t) − E(0), J (>= 0)
   double energy_scale = 0.0;      // common/health.h energy_scale, J
+  // What the scene can release inside the band, J: energy_scale (falling its
+  // own size) plus band_energy (every spring let go from the band's far edge).
+  // Equal to energy_scale without a limiter.
+  double energy_bound = 0.0;
   double seconds = 0.0;           // wall time of all steps
   std::string problem;            // empty unless the run became unstable (it stops there)
   int problem_step = -1;
   // A run without the energy check (check_energy false) whose total energy
   // still rose more than energy_scale above its start: the first such step
   // (-1: none) and common/health.h's energy_rise_problem line for it. The run
-  // went on: only the limiter kept it inside the band ("bounded only by the
-  // limiter", README.md).
+  // went on; energy_contained says whether the limiter held it ("Bounded only
+  // by the limiter", README.md).
   int energy_exceeded_step = -1;
   std::string energy_exceeded;
 };
+
+// True when a limited run whose total energy rose above energy_scale
+// (energy_exceeded_step >= 0) was still held by its limiter: it did not stop,
+// `band_held` (a spring-limited run inside the band ± band_tolerance(K)
+// throughout; pass true for the triangle limiters, which bound triangles, not
+// springs), and its largest rise stayed within energy_bound. A run whose
+// energy never rose above the scale has nothing to contain: false.
+bool energy_contained(const RunResult& result, bool band_held);
 
 using StepCallback = std::function<void(const StepRecord&, const Particles&)>;
 

@@ -13,6 +13,7 @@
 //     build/bin/lab05_strain_limiting_tests_solution "[lab05_given]"
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <catch2/catch.hpp>
 
@@ -97,4 +98,37 @@ TEST_CASE("a limited run whose energy stays below the scale reports nothing", "[
   CHECK(limited.max_energy_rise <= limited.energy_scale);
   CHECK(limited.energy_exceeded_step == -1);
   CHECK(limited.energy_exceeded.empty());
+}
+
+TEST_CASE("a rise of energy is contained only inside the band and within what the band can release",
+          "[lab05_given][limiter]") {
+  // band_energy: one spring of k = 100 N/m and L = 2 m, band [0.9, 1.2]: the
+  // far edge is 0.2 L = 0.4 m away, ½ · 100 · 0.4² = 8 J.
+  const std::vector<cl::Spring> springs{{0, 1, 2.0, 100.0}};
+  CHECK(cl::test::near(cl::lab05::band_energy(springs, 0.9, 1.2), 8.0, 1e-12, "band_energy (J)"));
+  CHECK(cl::test::near(cl::lab05::band_energy({}, 0.9, 1.1), 0.0, 0.0, "band_energy without springs (J)"));
+
+  // A run whose energy rose 20 J, past its 10 J scale, from step 5, with 40 J
+  // the scene can release inside the band.
+  cl::lab05::RunResult result;
+  result.energy_scale = 10.0;
+  result.energy_bound = 40.0;
+  result.energy_exceeded_step = 5;
+  result.max_energy_rise = 20.0;
+  CHECK(cl::test::answer("energy_contained(rise 20 J, bound 40 J, band held)",
+                         cl::lab05::energy_contained(result, true), true, "the limiter held band and energy"));
+  CHECK(cl::test::answer("energy_contained(rise 20 J, bound 40 J, band lost)",
+                         cl::lab05::energy_contained(result, false), false, "the band was lost: nothing held it"));
+  result.max_energy_rise = 41.0;
+  CHECK(cl::test::answer("energy_contained(rise 41 J, bound 40 J, band held)",
+                         cl::lab05::energy_contained(result, true), false, "past what the band allows"));
+  result.max_energy_rise = 20.0;
+  result.problem = "max strain 1e3: unstable";
+  CHECK(cl::test::answer("energy_contained(a run that stopped)", cl::lab05::energy_contained(result, true), false,
+                         "a run that stopped is reported unstable, not contained"));
+  result.problem.clear();
+  result.energy_exceeded_step = -1;
+  result.max_energy_rise = 5.0;
+  CHECK(cl::test::answer("energy_contained(rise 5 J, below the 10 J scale)", cl::lab05::energy_contained(result, true),
+                         false, "nothing rose past the scale: nothing to contain"));
 }

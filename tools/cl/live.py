@@ -17,9 +17,10 @@ import subprocess
 import sys
 import time
 
-from .base import CourseError
+from . import grade
+from .base import ROOT, CourseError
 from .build import BuildFailure, build_targets, configure
-from .labs import executable, resolve_lab
+from .labs import executable, lab_dirs, resolve_lab
 
 USAGE = "usage: ./course live labNN [--port N | --bench] [lab flags]  (labNN_solution: the reference)"
 
@@ -40,8 +41,19 @@ def live_command(argv):
             port = [value]
             del rest[at:at + (1 if "=" in word else 2)]
             break
+    if not has_live_mode(lab):
+        live_labs = ", ".join(grade.lab_id(other) for other in lab_dirs() if has_live_mode(other))
+        raise CourseError(f"live: {grade.lab_id(lab)} does not step in time, so it has no live mode "
+                          f"(the labs that do: {live_labs})", code=2)
     name = lab + ("_solution" if solution else "")
     return name, [name, "--live", *port, *rest]
+
+
+def has_live_mode(lab):
+    """Whether the lab's program takes --live: its driver adds common/live.h's
+    flag (the time-stepping labs do; the sweep labs 01-03 do not)."""
+    main = ROOT / "labs" / lab / "main.cpp"
+    return main.is_file() and "add_live_option(" in main.read_text()
 
 
 def read_url(process, seconds):
