@@ -66,10 +66,7 @@ def run_sanitized(log=sys.stdout):
 def configure_sanitized(log=sys.stdout):
     """Configure the sanitizer build (when new or its flags changed); return its test programs' names."""
     configure(log=log)  # labs.json says which labs have a reference
-    # A Release build whose course code CMakeLists.txt compiles at -Og -g1
-    # (GCC's level for debugging, which keeps every line and compiles a third
-    # faster than -O1 under the sanitizers: a lab 06 batch, 16.6 s of CPU
-    # against 25.7 s; -O0, 14.8 s, would run Eigen's code unoptimised).
+    # A Release build; CMakeLists.txt (CL_SANITIZE) gives the course's code its flags.
     cache = SANITIZE_BUILD / "CMakeCache.txt"
     text = cache.read_text() if cache.is_file() else ""
     if "CL_SANITIZE:BOOL=ON" not in text or "CMAKE_BUILD_TYPE:STRING=Release" not in text:
@@ -124,13 +121,17 @@ class BackgroundSuite:
         return subprocess.Popen(["nice", "-n", "10", *command], cwd=ROOT, stdout=self.output,
                                 stderr=subprocess.STDOUT, text=True, start_new_session=True)
 
+    def start_second_phase(self):
+        """The build's second phase, which becomes the build's process (send reaches it)."""
+        self.process = self.start_build(self.phases[1])
+        return self.process
+
     def work(self):
         try:
             code = wait_counted(self.process)
             if code == 0:
                 self.main_built.wait()
-                self.process = self.start(self.phases[1], starter=self.start_build)
-                code = wait_counted(self.process)
+                code = wait_counted(self.when_free(self.start_second_phase))
             self.build_seconds = time.monotonic() - self.started
             self.build_cpu = background_cpu()
             self.output.seek(0)
@@ -176,20 +177,21 @@ class BackgroundSuite:
                 self.send(signal.SIGCONT)
                 self.gate.set()
 
-    def start(self, command, starter=None, **options):
-        """Popen(command) once the background may run (not while paused), counted
-        among those running; `starter`: the build's second phase, which is the
-        build's process instead (send reaches it as such)."""
+    def when_free(self, launch):
+        """launch() under the lock once the background may run (not while paused); its result."""
         while True:
             self.gate.wait()
             with self.lock:
                 if self.gate.is_set():
-                    if starter is not None:
-                        self.process = starter(command)
-                        return self.process
-                    process = subprocess.Popen(command, **options)
-                    self.running.add(process)
-                    return process
+                    return launch()
+
+    def start(self, command, **options):
+        """Popen(command) once the background may run, counted among those running."""
+        def launch():
+            process = subprocess.Popen(command, **options)
+            self.running.add(process)
+            return process
+        return self.when_free(launch)
 
     def finish(self):
         """Wait for the build and the runs; return [(program, ok, summary line,
