@@ -10,6 +10,10 @@ replaces the text between the results markers of bench/README.md and between
 the trade markers of README.md. Every number between the markers is this
 run's: the pages say so, and nothing there is edited by hand. --machine says
 what the run shared the machine with (the load), which no CSV records.
+The run's end is trade.csv's modification time; a copied folder loses it
+(cp without -p), so --ended "YYYY-MM-DD HH:MM[:SS]" (UTC) gives it instead.
+The command in the header is the one trade.log recorded (its output folder
+shortened to out/...), not the folder this script reads.
 With --extremes DIR (an extremes run's folder: extremes_counts.csv,
 extremes.csv, and extremes.log, its terminal output) the counts per method go
 between the extremes markers of bench/README.md as well.
@@ -56,10 +60,13 @@ def number(text):
 
 def read_log(path):
     """The run's settings line and its summary (runs, scenes, seconds), when the log is there."""
-    found = {"settings": None, "summary": None, "seconds": None}
+    found = {"settings": None, "summary": None, "seconds": None, "command": None}
     if not path.exists():
         return found
     for line in path.read_text().splitlines():
+        command = re.match(r"\s*trade( --\S.*)$", line)
+        if command and found["command"] is None:  # ./course's echo of the program's arguments
+            found["command"] = "build/bin/trade" + re.sub(r"(?<=\s)\S*/(out/\S+)", r"\1", command.group(1))
         if line.startswith("trade: ") and " scenes x " in line:
             found["settings"] = line[len("trade: "):]
         match = re.match(r"trade: (\d+) runs on (\d+) scenes in (\d+) s", line)
@@ -128,7 +135,7 @@ def label(scene, start):
 # ---------------------------------------------------------------- the run
 
 class Run:
-    def __init__(self, folder):
+    def __init__(self, folder, ended=None):
         self.folder = folder
         self.runs = read(folder / "trade.csv")
         self.scenes = sorted(read(folder / "trade_scenes.csv"),
@@ -140,7 +147,8 @@ class Run:
         self.contact = read(contact) if contact.exists() else []
         self.family = {r["method"]: r["family"] for r in self.runs}
         self.log = read_log(folder / "trade.log")
-        self.ended = datetime.datetime.fromtimestamp((folder / "trade.csv").stat().st_mtime, datetime.timezone.utc)
+        self.ended = ended or datetime.datetime.fromtimestamp((folder / "trade.csv").stat().st_mtime,
+                                                              datetime.timezone.utc)
 
     def cell(self, method, iterations, seconds):
         """pd K=5, 2.1 ms (a direct solve has no K)."""
@@ -187,7 +195,8 @@ class Run:
         length = f"{seconds} s ({seconds / 60:.0f} min)" if seconds else "length not recorded (no trade.log)"
         scenes = ", ".join(dict.fromkeys(s["scene"] for s in self.scenes)) + (", " + ", ".join(
             dict.fromkeys(r["scene"] for r in self.contact)) if self.contact else "")
-        lines = [f"**The run**: {when}, `build/bin/trade --out {self.folder}`, {length}; "
+        command = self.log["command"] or f"build/bin/trade --out {self.folder}"
+        lines = [f"**The run**: {when}, `{command}`, {length}; "
                  f"{len(self.runs)} runs of {len(self.family)} methods on {scenes}, from "
                  + " and ".join(f"the {start} start" for start in self.starts)
                  + (f" (and {len(self.contact)} contact runs)" if self.contact else "") + "."]
@@ -449,13 +458,22 @@ def main(argv):
     parser.add_argument("folder", nargs="?", default="out/bench", help="the run's CSV folder (default out/bench)")
     parser.add_argument("--machine", default="", help="the machine's state during the run (load), in words")
     parser.add_argument("--extremes", metavar="DIR", help="also the extremes run in DIR (extremes_counts.csv, extremes.log)")
+    parser.add_argument("--ended", metavar="'YYYY-MM-DD HH:MM[:SS]'",
+                        help="when the trade ended (UTC), for a folder copied without its files' times")
     parser.add_argument("--print", action="store_true", help="print the two sections instead of writing the pages")
     args = parser.parse_args(argv)
     folder = Path(args.folder)
     if not (folder / "trade.csv").exists():
         print(f"report: no {folder / 'trade.csv'}; make it with build/bin/trade --out {folder}", file=sys.stderr)
         return 2
-    run = Run(folder)
+    ended = None
+    if args.ended:
+        try:
+            ended = datetime.datetime.fromisoformat(args.ended).replace(tzinfo=datetime.timezone.utc)
+        except ValueError:
+            print(f"report: --ended {args.ended!r} is not YYYY-MM-DD HH:MM[:SS]", file=sys.stderr)
+            return 2
+    run = Run(folder, ended)
     if args.print:
         print("\n".join(bench_section(run, args.machine) + [""] + readme_section(run)))
         return 0
