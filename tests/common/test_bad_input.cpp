@@ -30,10 +30,13 @@ std::string read(const fs::path& path) {
   return text.str();
 }
 
+// The lab executable the rules are run through: CL_PROBE_EXE, beside this
+// program in bin/ (CMakeLists.txt).
+fs::path probe() { return fs::read_symlink("/proc/self/exe").parent_path() / CL_PROBE_EXE; }
+
 RunResult run_probe(const std::string& arguments, const fs::path& dir) {
   const fs::path err = dir / "stderr.txt";
-  const std::string command = std::string("'") + CL_PROBE_EXE + "' " + arguments + " > /dev/null 2> '" +
-                              err.string() + "'";
+  const std::string command = "'" + probe().string() + "' " + arguments + " > /dev/null 2> '" + err.string() + "'";
   const int status = std::system(command.c_str());
   RunResult result;
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
