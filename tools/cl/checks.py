@@ -49,12 +49,15 @@ class Checks:
         self.times = []  # (step, seconds, CPU seconds or None, ran alongside other steps)
 
     @contextmanager
-    def timed(self, step):
+    def timed(self, step, concurrent=False):
+        """Time the step; `concurrent`: it ran beside another (its wall time only,
+        a row without a share, its CPU inside the row of the steps around it)."""
         start, cpu = time.monotonic(), foreground_cpu()
         try:
             yield
         finally:
-            self.add_time(step, time.monotonic() - start, cpu=foreground_cpu() - cpu)
+            self.add_time(step, time.monotonic() - start, concurrent=concurrent,
+                          cpu=None if concurrent else foreground_cpu() - cpu)
 
     def add_time(self, step, seconds, concurrent=False, cpu=None):
         self.times.append((step, seconds, cpu, concurrent))
@@ -459,13 +462,13 @@ def cmd_test(argv):
         with checks.timed("student loop, autograder and mistakes (two lanes; CPU of all three)"):
             mistakes = Beside(checks, "  mistakes: the newest labs' catalogues, one entry of the others",
                               check_mistakes, labs)
-            start = time.monotonic()
-            check_student_loop(checks)
-            checks.add_time("  student loop (a temporary release)", time.monotonic() - start, concurrent=True)
-            start = time.monotonic()
-            check_autograder(checks)
-            checks.add_time("  autograder (a bundle, five submissions)", time.monotonic() - start, concurrent=True)
-            mistakes.join()
+            try:
+                with checks.timed("  student loop (a temporary release)", concurrent=True):
+                    check_student_loop(checks)
+                with checks.timed("  autograder (a bundle, five submissions)", concurrent=True):
+                    check_autograder(checks)
+            finally:
+                mistakes.join()  # its checks are recorded even if the lane beside it raised
         if sanitizing is not None:
             check_sanitize(checks, sanitizing)
     return checks.finish()
