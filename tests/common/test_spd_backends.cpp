@@ -132,6 +132,13 @@ TEST_CASE("both factorizations refuse a singular or indefinite matrix instead of
     CHECK_FALSE(factor.refactor(spd));
     CHECK_FALSE(factor.ok());
     CHECK_THROWS_AS(factor.solve(Eigen::VectorXd::Zero(2)), std::logic_error);
+    // ... and definite values again on that pattern (lab 13's retry after a
+    // refusal): the factor left by the refusal is refilled, and it solves.
+    spd.coeffRef(1, 1) = 3.0;
+    REQUIRE(factor.refactor(spd));
+    const Eigen::Vector2d b(1.0, -2.0);
+    const Eigen::Vector2d expected = Eigen::Matrix2d(Eigen::MatrixXd(spd)).ldlt().solve(b);
+    CHECK_THAT((factor.solve(b) - expected).cwiseAbs().maxCoeff(), WithinAbs(0.0, 1e-14));
   }
 }
 
