@@ -348,16 +348,20 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
     return stop;
   };
   const InverseApply initial = [&](const Eigen::VectorXd& v) { return apply_inverse(factor_, v); };
-  auto moved = [&](const Eigen::VectorXd& direction, double alpha) {
-    Eigen::Matrix3Xd trial = x;
+  // x + alpha·direction into `trial`, which keeps its storage from one try
+  // and one iteration to the next (no allocation inside the loop).
+  Eigen::Matrix3Xd trial = x;
+  auto move_to_trial = [&](const Eigen::VectorXd& direction, double alpha) {
+    trial = x;
     for (int u = 0; u < map.unknowns(); ++u) {
       trial.col(map.particle_of[static_cast<std::size_t>(u)]) += alpha * direction.segment<3>(3 * u);
     }
-    return trial;
   };
   // The pairs, oldest first, handed to lbfgs_direction as they are (no copy
-  // per iteration): dropping the oldest moves the others' vectors, not their values.
+  // per iteration). Once m are kept, the oldest pair's vectors are rotated to
+  // the back and overwritten by the newest: the same values, no allocation.
   std::vector<CurvaturePair> history;
+  history.reserve(static_cast<std::size_t>(settings.history));
   double g = lab06::objective(problem, x, y);
   Eigen::VectorXd gradient = lab06::newton_gradient(problem, x, y);
   bool stopped = record(0, g);
@@ -379,7 +383,6 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
       break;
     }
     double alpha = 1.0;
-    Eigen::Matrix3Xd trial;
     double value = 0.0;
     Eigen::VectorXd next_gradient;
     bool polish = !(-0.5 * slope > 8.0 * kEpsilon * std::abs(g));
@@ -387,7 +390,7 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
       bool accepted = false;
       double full_step_value = 0.0;
       for (int halving = 0; halving < 60; ++halving, alpha *= 0.5) {
-        trial = moved(direction, alpha);
+        move_to_trial(direction, alpha);
         value = lab06::objective(problem, trial, y);
         if (halving == 0) full_step_value = value;
         if (value <= g + 1e-4 * alpha * slope) {
@@ -413,7 +416,7 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
         report.converged = true;
         break;
       }
-      trial = moved(direction, 1.0);
+      move_to_trial(direction, 1.0);
       value = lab06::objective(problem, trial, y);
       next_gradient = lab06::newton_gradient(problem, trial, y);
       if (!(next_gradient.norm() < gradient.norm())) {
@@ -424,11 +427,16 @@ StepReport Solver::lbfgs_pd(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& y, cons
       next_gradient = lab06::newton_gradient(problem, trial, y);
     }
     if (settings.history > 0) {
-      history.push_back({alpha * direction, next_gradient - gradient});
-      if (static_cast<int>(history.size()) > settings.history) history.erase(history.begin());
+      if (static_cast<int>(history.size()) < settings.history) {
+        history.emplace_back();
+      } else {
+        std::rotate(history.begin(), history.begin() + 1, history.end());
+      }
+      history.back().s = alpha * direction;
+      history.back().y = next_gradient - gradient;
     }
-    x = trial;
-    gradient = next_gradient;
+    x.swap(trial);
+    gradient.swap(next_gradient);
     const double previous = g;
     g = value;
     report.iterations_done = k;
