@@ -156,6 +156,24 @@ class SerialOpenMpRegions {
   int saved_ = 0;
 };
 
+// CHOLMOD's header over compressed-column arrays of an n × n symmetric
+// matrix whose lower triangle (rows sorted in each column) is what counts.
+cholmod_sparse lower_triangle(std::size_t n, std::size_t entries, int* outer, int* inner, double* values) {
+  cholmod_sparse view{};
+  view.nrow = view.ncol = n;
+  view.nzmax = entries;
+  view.p = outer;
+  view.i = inner;
+  view.x = values;
+  view.stype = -1;
+  view.itype = CHOLMOD_INT;
+  view.xtype = CHOLMOD_REAL;
+  view.dtype = CHOLMOD_DOUBLE;
+  view.sorted = 1;
+  view.packed = 1;
+  return view;
+}
+
 }  // namespace
 
 // One CHOLMOD workspace and factor per SpdFactorization that uses it.
@@ -251,18 +269,8 @@ struct SpdFactorization::Cholmod {
   bool numeric(const SparseMatrix& a) {
     const double* values = a.valuePtr();
     for (std::size_t k = 0; k < source.size(); ++k) permuted_values[k] = values[source[k]];
-    cholmod_sparse s{};
-    s.nrow = s.ncol = static_cast<std::size_t>(a.rows());
-    s.nzmax = permuted_values.size();
-    s.p = permuted_outer.data();
-    s.i = permuted_inner.data();
-    s.x = permuted_values.data();
-    s.stype = -1;
-    s.itype = CHOLMOD_INT;
-    s.xtype = CHOLMOD_REAL;
-    s.dtype = CHOLMOD_DOUBLE;
-    s.sorted = 1;
-    s.packed = 1;
+    cholmod_sparse s = lower_triangle(static_cast<std::size_t>(a.rows()), permuted_values.size(),
+                                      permuted_outer.data(), permuted_inner.data(), permuted_values.data());
     double beta[2] = {0.0, 0.0};
     common.status = CHOLMOD_OK;
     return cholmod_super_numeric(&s, nullptr, beta, factor, &common) != 0;
@@ -273,20 +281,9 @@ namespace {
 
 // CHOLMOD's view of a compressed Eigen matrix (no copy): its lower triangle.
 cholmod_sparse view_of(const SparseMatrix& a) {
-  cholmod_sparse view{};
-  view.nrow = static_cast<std::size_t>(a.rows());
-  view.ncol = static_cast<std::size_t>(a.cols());
-  view.nzmax = static_cast<std::size_t>(a.nonZeros());
-  view.p = const_cast<int*>(a.outerIndexPtr());
-  view.i = const_cast<int*>(a.innerIndexPtr());
-  view.x = const_cast<double*>(a.valuePtr());
-  view.stype = -1;
-  view.itype = CHOLMOD_INT;
-  view.xtype = CHOLMOD_REAL;
-  view.dtype = CHOLMOD_DOUBLE;
-  view.sorted = 1;
-  view.packed = 1;
-  return view;
+  return lower_triangle(static_cast<std::size_t>(a.rows()), static_cast<std::size_t>(a.nonZeros()),
+                        const_cast<int*>(a.outerIndexPtr()), const_cast<int*>(a.innerIndexPtr()),
+                        const_cast<double*>(a.valuePtr()));
 }
 
 // Solves A X = B for B's columns (column-major, n × columns) in place.
