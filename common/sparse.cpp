@@ -441,6 +441,7 @@ bool SpdFactorization::accept_pivots(Eigen::Index rows) {
   for (Eigen::Index k = 0; k < d.size(); ++k) {
     if (!std::isfinite(d[k]) || !(d[k] > floor)) return false;
   }
+  inverse_d_ = d.cwiseInverse();
   ok_ = true;
   size_ = rows;
   return true;
@@ -475,37 +476,38 @@ RowsX3 SpdFactorization::solve3(const RowsX3& b) const {
 #endif
   // A = Pᵀ L D Lᵀ P with L unit lower triangular, stored without its diagonal.
   // y = P b; L z = y; w = D⁻¹ z; Lᵀ u = w; x = Pᵀ u — each loop over L's
-  // columns moves all three coordinates together.
+  // columns moves all three coordinates together. The loops are bound by
+  // reading L (value and row index, 12 bytes an entry, twice a solve): each
+  // entry's value is read into a local once (a store through `row` may alias
+  // `value`, so the compiler would reload it after each of the three), and
+  // D⁻¹ (kept since the factorization: no division here) is applied as the
+  // backward pass reaches each row — the same products as a separate pass.
   RowsX3 y = ldlt_.permutationP() * b;
   const SparseMatrix& lower = ldlt_.matrixL().nestedExpression();
   const int* outer = lower.outerIndexPtr();
   const int* inner = lower.innerIndexPtr();
   const double* value = lower.valuePtr();
+  const double* inverse_d = inverse_d_.data();
   double* data = y.data();
   const Eigen::Index n = size_;
   for (Eigen::Index j = 0; j < n; ++j) {
     const double y0 = data[3 * j], y1 = data[3 * j + 1], y2 = data[3 * j + 2];
-    for (int p = outer[j]; p < outer[j + 1]; ++p) {
+    for (int p = outer[j], end = outer[j + 1]; p < end; ++p) {
+      const double l = value[p];
       double* row = data + 3 * inner[p];
-      row[0] -= value[p] * y0;
-      row[1] -= value[p] * y1;
-      row[2] -= value[p] * y2;
+      row[0] -= l * y0;
+      row[1] -= l * y1;
+      row[2] -= l * y2;
     }
   }
-  const Eigen::VectorXd& d = ldlt_.vectorD();
-  for (Eigen::Index j = 0; j < n; ++j) {
-    const double inverse = 1.0 / d[j];
-    data[3 * j] *= inverse;
-    data[3 * j + 1] *= inverse;
-    data[3 * j + 2] *= inverse;
-  }
   for (Eigen::Index j = n - 1; j >= 0; --j) {
-    double s0 = data[3 * j], s1 = data[3 * j + 1], s2 = data[3 * j + 2];
-    for (int p = outer[j]; p < outer[j + 1]; ++p) {
+    double s0 = data[3 * j] * inverse_d[j], s1 = data[3 * j + 1] * inverse_d[j], s2 = data[3 * j + 2] * inverse_d[j];
+    for (int p = outer[j], end = outer[j + 1]; p < end; ++p) {
+      const double l = value[p];
       const double* row = data + 3 * inner[p];
-      s0 -= value[p] * row[0];
-      s1 -= value[p] * row[1];
-      s2 -= value[p] * row[2];
+      s0 -= l * row[0];
+      s1 -= l * row[1];
+      s2 -= l * row[2];
     }
     data[3 * j] = s0;
     data[3 * j + 1] = s1;

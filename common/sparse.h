@@ -150,6 +150,7 @@ class SpdFactorization {
   SpdBackend choice_;
   SpdBackend backend_ = SpdBackend::kSimplicial;
   mutable Ldlt ldlt_;              // supernodal: computed by eigen() on demand
+  Eigen::VectorXd inverse_d_;      // simplicial: 1 / D, for solve3
   mutable bool ldlt_stale_ = false;  // supernodal: ldlt_ is not this factor's
   std::vector<double> values_;     // supernodal: the factored values, for eigen()
   std::unique_ptr<Cholmod> cholmod_;
