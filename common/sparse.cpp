@@ -460,7 +460,6 @@ bool SpdFactorization::numeric(const SparseMatrix& a) {
   // as accept_pivots. NaN fails the comparison too.
   const double rcond = cholmod_rcond(factor, &cholmod_->common);
   if (!(rcond > static_cast<double>(a.rows()) * 1e-15)) return false;
-  values_.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
   ldlt_stale_ = true;
   ok_ = true;
   size_ = a.rows();
@@ -495,12 +494,22 @@ void SpdFactorization::require_factor(Eigen::Index rows) const {
 }
 
 const Eigen::SimplicialLDLT<SparseMatrix>& SpdFactorization::eigen() const {
+#ifdef CL_HAVE_CHOLMOD
   if (backend_ == SpdBackend::kSupernodal && ok_ && ldlt_stale_) {
-    const Eigen::Map<const SparseMatrix> matrix(size_, size_, static_cast<Eigen::Index>(values_.size()),
-                                                analyzed_outer_.data(), analyzed_inner_.data(), values_.data());
+    // The factored matrix's lower triangle, put back in A's places from the
+    // permuted copy CHOLMOD read (Cholmod::numeric; ok_ means it is the last
+    // one's): no copy of A's values on each factorization for a call that
+    // seldom comes. The upper triangle stays 0: Eigen's LDLᵀ reads the lower.
+    std::vector<double> values(analyzed_inner_.size(), 0.0);
+    for (std::size_t k = 0; k < cholmod_->source.size(); ++k) {
+      values[static_cast<std::size_t>(cholmod_->source[k])] = cholmod_->permuted_values[k];
+    }
+    const Eigen::Map<const SparseMatrix> matrix(size_, size_, static_cast<Eigen::Index>(values.size()),
+                                                analyzed_outer_.data(), analyzed_inner_.data(), values.data());
     ldlt_.compute(SparseMatrix(matrix));
     ldlt_stale_ = false;
   }
+#endif
   return ldlt_;
 }
 

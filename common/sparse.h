@@ -152,7 +152,6 @@ class SpdFactorization {
   mutable Ldlt ldlt_;              // supernodal: computed by eigen() on demand
   Eigen::VectorXd inverse_d_;      // simplicial: 1 / D, for solve3
   mutable bool ldlt_stale_ = false;  // supernodal: ldlt_ is not this factor's
-  std::vector<double> values_;     // supernodal: the factored values, for eigen()
   std::unique_ptr<Cholmod> cholmod_;
   bool ok_ = false;
   int factorizations_ = 0;

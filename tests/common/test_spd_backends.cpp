@@ -167,6 +167,16 @@ TEST_CASE("the automatic choice is supernodal exactly when CHOLMOD is there and 
   const Eigen::MatrixXd many_expected = reference.eigen().solve(many);
   CHECK_THAT(max_abs(large_automatic.eigen().solve(many) - many_expected),
              WithinAbs(0.0, 1e-9 * max_abs(many_expected)));
+  // ... and of the last matrix factored: after a refactor with other values
+  // (2A: the solution halves), and after a refused one followed by 2A again.
+  const cl::SparseMatrix doubled = 2.0 * large;
+  REQUIRE(large_automatic.refactor(doubled));
+  CHECK_THAT(max_abs(large_automatic.eigen().solve(many) - 0.5 * many_expected),
+             WithinAbs(0.0, 1e-9 * max_abs(many_expected)));
+  REQUIRE_FALSE(large_automatic.refactor(-1.0 * large));
+  REQUIRE(large_automatic.refactor(doubled));
+  CHECK_THAT(max_abs(large_automatic.eigen().solve(many) - 0.5 * many_expected),
+             WithinAbs(0.0, 1e-9 * max_abs(many_expected)));
 }
 
 TEST_CASE("one BLAS thread gives the supernodal factorization's solves and a count below 1 is refused",
