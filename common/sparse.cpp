@@ -136,9 +136,9 @@ namespace {
 // A region that runs on one thread still costs a system call: libgomp ends
 // every region with its team's final barrier, whose last thread wakes the
 // others with futex(FUTEX_WAKE) whether or not any sleeps (libgomp's
-// config/linux/bar.c). CHOLMOD opens about a hundred regions a supernode
-// step: 4,700 wake calls in one factorization of lab 13's 128² Schur
-// complement, ~10 % of its time (strace, perf). So while the guard is up, the
+// config/linux/bar.c). CHOLMOD opens a few regions per supernode: about
+// 4,700 wake calls in each factorization of lab 13's 128² Schur complement
+// (strace), about 8 % of lab 13's iteration there. So while the guard is up, the
 // calling thread's regions skip libgomp altogether: GOMP_parallel below (the
 // one entry point CHOLMOD calls) runs the region's body on the calling thread,
 // which is what a team of one does (omp_get_thread_num() = 0 and
@@ -229,7 +229,8 @@ struct SpdFactorization::Cholmod {
     // columns, or at most 64 with ≤ 30 % explicit zeros, or 128 with ≤ 20 %.
     // Fewer, larger supernodes mean fewer (and larger) BLAS calls and fewer of
     // the per-supernode OpenMP regions that SerialOpenMpRegions runs on one
-    // thread (each still costs a system call on its way out). Measured on the
+    // thread (then each still cost a system call on its way out; now none,
+    // see GOMP_parallel). Measured on the
     // curtains at k = 1e6, one thread, idle: lab 06's Newton iteration 0.130 →
     // 0.092 s on 128², 0.026 → 0.016 s on 64², 0.0050 → 0.0031 s on 32²;
     // lab 13's 0.137 → 0.104 s on 128². Only the numeric factorization's

@@ -3,6 +3,7 @@
 // round-off, refuse the same singular and indefinite matrices, and kAutomatic
 // chooses by the flop count it documents. Without CHOLMOD in the build the
 // supernodal requests fall back to Eigen, and the same checks hold.
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -255,4 +256,20 @@ TEST_CASE("the supernodal factorization starts no OpenMP threads and leaves max-
   CHECK(x.allFinite());
   CHECK(process_threads() == before);
   CHECK(get_levels() == 3);
+}
+
+TEST_CASE("outside CHOLMOD an OpenMP region still gets libgomp's threads", "[sparse][backend]") {
+  // common/sparse.cpp defines GOMP_parallel, libgomp's entry point for
+  // `#pragma omp parallel`, so that CHOLMOD's regions run inline while it
+  // factors; every other region (lab 03's and lab 12's sweeps) must still
+  // reach libgomp and its team. A region asked for two threads runs its body
+  // on two.
+  if (!cl::cholmod_available()) return;
+  using Body = void (*)(void*);
+  using Parallel = void (*)(Body, void*, unsigned, unsigned);
+  const auto parallel = reinterpret_cast<Parallel>(dlsym(RTLD_DEFAULT, "GOMP_parallel"));
+  REQUIRE(parallel != nullptr);  // CHOLMOD links libgomp
+  std::atomic<int> bodies{0};
+  parallel([](void* count) { static_cast<std::atomic<int>*>(count)->fetch_add(1); }, &bodies, 2, 0);
+  CHECK(bodies.load() == 2);
 }
