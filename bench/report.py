@@ -383,10 +383,10 @@ def bench_section(run, machine):
                   f"residual), with the K and the time per step of that run ({run.caps()}):", ""]
         lines += best_per_method(run, start) + [""]
     lines += ["#### The Newtons per K", "",
-              "Lab 06's Newton and lab 13's two variants: the residual over the start's and the median time "
-              f"per step, per K, until the cap ({run.caps()}):", ""]
+              "Lab 06's Newton and lab 13's two variants on the largest curtains: the residual over the start's "
+              f"and the median time per step, per K, until the cap ({run.caps()}):", ""]
     for start in run.starts:
-        lines += newtons_per_k(run, start, 32 if start == "trajectory" else 128)
+        lines += newtons_per_k(run, start, 64 if start == "trajectory" else 128)
     lines += ["#### Time per iteration against size", "",
               f"Per method the run with K nearest 10 (a direct solve: per step) from the {run.starts[0]} start, "
               "fitted time ~ nᵖ over the curtains:", ""]
