@@ -141,6 +141,7 @@ class ContactStepper {
   MovableMap map_;
   Eigen::VectorXd xpbd_lambda_;
   SpdFactorization schur_;  // the springs' Schur matrix: its pattern is the same every step (refactor)
+  std::vector<Triplet> schur_entries_;  // its entries, refilled each time (schur_matrix)
 };
 
 // What one frame looked like (frame 0: the initial state).
