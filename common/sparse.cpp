@@ -344,6 +344,37 @@ void cholmod_solve_columns(cholmod_factor* factor, cholmod_common& common, doubl
   cholmod_free_dense(&x, &common);
 }
 
+// CHOLMOD's AMD order of `a`'s lower triangle (order[k]: the row of `a` that
+// comes k-th), for Eigen's simplicial factorization. It leaves fewer entries
+// in L than Eigen's AMD (a port of CSparse's) on the course's matrices: PD's A
+// on the 128² curtain 514,225 instead of 574,742 (0.89×), on 64² 98,169
+// instead of 105,344 (0.93×); METIS gave 552,288 at 128². Each solve3 reads
+// every entry of L twice, so that is the solve's cost. Returns false if
+// CHOLMOD fails (out of memory): Eigen's own AMD then.
+bool cholmod_amd_order(const SparseMatrix& a, std::vector<int>& order) {
+  cholmod_common common;
+  cholmod_start(&common);
+  common.print = 0;
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_AMD;
+  common.postorder = 1;
+  common.supernodal = CHOLMOD_SIMPLICIAL;  // the order and column counts only
+  cholmod_sparse view = view_of(a);
+  cholmod_factor* symbolic = nullptr;
+  {
+    const SerialOpenMpRegions serial;
+    symbolic = cholmod_analyze(&view, &common);
+  }
+  const bool ok = symbolic != nullptr;
+  if (ok) {
+    const int* perm = static_cast<const int*>(symbolic->Perm);
+    order.assign(perm, perm + a.rows());
+    cholmod_free_factor(&symbolic, &common);
+  }
+  cholmod_finish(&common);
+  return ok;
+}
+
 }  // namespace
 #else
 bool cholmod_available() { return false; }
@@ -368,6 +399,17 @@ double SpdFactorization::Ldlt::flops() const {
     sum += below * below;
   }
   return sum;
+}
+
+void SpdFactorization::Ldlt::analyze_in_order(const SparseMatrix& a, const std::vector<int>& order) {
+  // What Eigen's analyzePattern does after its own ordering (its ordering()
+  // computes P⁻¹ too, then P and the permuted upper triangle).
+  m_Pinv.resize(a.rows());
+  std::copy(order.begin(), order.end(), m_Pinv.indices().data());
+  m_P = m_Pinv.inverse();
+  CholMatrixType permuted(a.rows(), a.cols());
+  permuted.selfadjointView<Eigen::Upper>() = a.selfadjointView<Eigen::Lower>().twistedBy(m_P);
+  analyzePattern_preordered(permuted, true);
 }
 
 SpdFactorization::SpdFactorization(SpdBackend choice) : choice_(choice) {}
@@ -419,7 +461,16 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
   }
 #endif
   if (backend_ == SpdBackend::kSimplicial) {
+#ifdef CL_HAVE_CHOLMOD
+    std::vector<int> order;
+    if (cholmod_amd_order(*matrix, order)) {
+      ldlt_.analyze_in_order(*matrix, order);
+    } else {
+      ldlt_.analyzePattern(*matrix);
+    }
+#else
     ldlt_.analyzePattern(*matrix);
+#endif
     flops_ = ldlt_.flops();
   }
   analyzed_outer_.assign(matrix->outerIndexPtr(), matrix->outerIndexPtr() + matrix->outerSize() + 1);
@@ -481,9 +532,43 @@ bool SpdFactorization::accept_pivots(Eigen::Index rows) {
     if (!std::isfinite(d[k]) || !(d[k] > floor)) return false;
   }
   inverse_d_ = d.cwiseInverse();
+  share_rows();
   ok_ = true;
   size_ = rows;
   return true;
+}
+
+// Columns j and j + 1 of L often have the same rows below j + 1 (a
+// supernode: column j's rows are j + 1 and then column j + 1's). Then column
+// j + 1's row list is column j's without its first entry, and a run of such
+// columns needs one list, each column starting one entry later. On PD's
+// curtains that is 117,187 indices instead of 574,742 at 128² (27,773 instead
+// of 105,344 at 64²), so solve3 reads 8 bytes an entry of L instead of 12;
+// the values, and the order in which solve3 uses them, are unchanged.
+// Checked entry by entry, so any pattern is right (a column that does not
+// nest gets a list of its own). Made after every numeric factorization:
+// Eigen writes L's row indices there, and one pass over them costs little
+// next to the factorization itself.
+void SpdFactorization::share_rows() {
+  const SparseMatrix& lower = ldlt_.matrixL().nestedExpression();
+  const int* outer = lower.outerIndexPtr();
+  const int* inner = lower.innerIndexPtr();
+  const auto n = static_cast<int>(lower.outerSize());
+  column_rows_.resize(static_cast<std::size_t>(n));
+  nests_next_.assign(static_cast<std::size_t>(n), 0);
+  shared_rows_.clear();
+  for (int j = 0; j < n; ++j) {
+    const int count = outer[j + 1] - outer[j];
+    const bool nested = j > 0 && outer[j] - outer[j - 1] == count + 1 && inner[outer[j - 1]] == j &&
+                  std::equal(inner + outer[j], inner + outer[j + 1], inner + outer[j - 1] + 1);
+    if (nested) {
+      column_rows_[static_cast<std::size_t>(j)] = column_rows_[static_cast<std::size_t>(j) - 1] + 1;
+      nests_next_[static_cast<std::size_t>(j) - 1] = 1;
+    } else {
+      column_rows_[static_cast<std::size_t>(j)] = static_cast<int>(shared_rows_.size());
+      shared_rows_.insert(shared_rows_.end(), inner + outer[j], inner + outer[j + 1]);
+    }
+  }
 }
 
 void SpdFactorization::require_factor(Eigen::Index rows) const {
@@ -525,44 +610,131 @@ RowsX3 SpdFactorization::solve3(const RowsX3& b) const {
 #endif
   // A = Pᵀ L D Lᵀ P with L unit lower triangular, stored without its diagonal.
   // y = P b; L z = y; w = D⁻¹ z; Lᵀ u = w; x = Pᵀ u — each loop over L's
-  // columns moves all three coordinates together, about 3 cycles an entry of
-  // L a pass (the backward pass's sums are chains, their order the result's
-  // bits). Each entry's value is read into a local once (a store through `row` may alias
-  // `value`, so the compiler would reload it after each of the three), and
-  // D⁻¹ (kept since the factorization: no division here) is applied as the
-  // backward pass reaches each row — the same products as a separate pass.
-  RowsX3 y = ldlt_.permutationP() * b;
+  // columns moves all three coordinates together. Each entry's value is read
+  // into a local once (a store through `row` may alias `value`, so the
+  // compiler would reload it after each of the three), and D⁻¹ (kept since
+  // the factorization: no division here) is applied as the backward pass
+  // reaches each row — the same products as a separate pass. P and Pᵀ are the
+  // gather into y and the write of each finished row into x (not Eigen's
+  // permutation products: two more n × 3 temporaries and passes).
+  //
+  // The passes cost what they read: 12 bytes an entry of L (value and row
+  // index; 6.9 MB at 128², beyond L2) and a row of y per entry. So the row
+  // indices come from the shared lists (share_rows: 8 bytes an entry), and
+  // where column j + 1 nests in column j (nests_next_) the two columns go
+  // through their common rows together: each such row of y is read (and in
+  // the forward pass written) once for both. With CHOLMOD's order
+  // (cholmod_amd_order: fewer entries), lab 06's PD iteration, its executable
+  // against the one before (--iterations 100, two sessions of 5–7
+  // alternating pairs, ratio of the medians of wall time per iteration, a
+  // shared noisy machine): 64² 0.33 → 0.29 ms (0.87×, 0.88×), 128² 1.91 →
+  // 1.45 ms and 1.75 → 1.42 ms (0.76×, 0.81×). The solve alone, timed inside
+  // the iteration against the previous solve3 in one process (CPU time):
+  // 0.63–0.74× at 64², 0.61–0.65× at 128²; bench_lab06's BM_Solve3OnePass
+  // (the factor hot in cache): 0.55–0.62× at 128², 0.57–0.71× at 32².
+  //
+  // The forward pass subtracts in the same order as one column at a time (a
+  // row gets column j's product, then column j + 1's): the same bits for the
+  // same factor. The backward pass's pair subtracts column j + 1's result from
+  // column j's sum after their common rows rather than before them: round-off.
+  const Eigen::Index n = size_;
+  const auto& order = ldlt_.permutationPinv().indices();  // row j of P b is row order[j] of b
+  const bool permuted = order.size() == n;                // Eigen keeps none for the natural order
+  RowsX3 y(n, 3);
+  RowsX3 x(n, 3);
+  const double* source = b.data();
+  double* data = y.data();
+  double* solution = x.data();
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double* from = source + 3 * (permuted ? order[j] : j);
+    data[3 * j] = from[0];
+    data[3 * j + 1] = from[1];
+    data[3 * j + 2] = from[2];
+  }
   const SparseMatrix& lower = ldlt_.matrixL().nestedExpression();
   const int* outer = lower.outerIndexPtr();
-  const int* inner = lower.innerIndexPtr();
+  const int* column_rows = column_rows_.data();
+  const int* shared_rows = shared_rows_.data();
+  const char* nests_next = nests_next_.data();
   const double* value = lower.valuePtr();
   const double* inverse_d = inverse_d_.data();
-  double* data = y.data();
-  const Eigen::Index n = size_;
   for (Eigen::Index j = 0; j < n; ++j) {
     const double y0 = data[3 * j], y1 = data[3 * j + 1], y2 = data[3 * j + 2];
-    for (int p = outer[j], end = outer[j + 1]; p < end; ++p) {
-      const double l = value[p];
-      double* row = data + 3 * inner[p];
+    const int* rows = shared_rows + column_rows[j];
+    const double* column = value + outer[j];
+    const int count = outer[j + 1] - outer[j];
+    if (nests_next[j]) {
+      // Column j's first row is j + 1: finish it, then both columns together
+      // (column j + 1's entry k - 1 is on column j's row k).
+      const double l = column[0];
+      const double z0 = data[3 * j + 3] - l * y0, z1 = data[3 * j + 4] - l * y1, z2 = data[3 * j + 5] - l * y2;
+      data[3 * j + 3] = z0;
+      data[3 * j + 4] = z1;
+      data[3 * j + 5] = z2;
+      const double* next = value + outer[j + 1] - 1;
+      for (int k = 1; k < count; ++k) {
+        const double a = column[k], c = next[k];
+        double* row = data + 3 * rows[k];
+        row[0] = (row[0] - a * y0) - c * z0;
+        row[1] = (row[1] - a * y1) - c * z1;
+        row[2] = (row[2] - a * y2) - c * z2;
+      }
+      ++j;
+      continue;
+    }
+    for (int k = 0; k < count; ++k) {
+      const double l = column[k];
+      double* row = data + 3 * rows[k];
       row[0] -= l * y0;
       row[1] -= l * y1;
       row[2] -= l * y2;
     }
   }
+  auto finish = [&](Eigen::Index j, double s0, double s1, double s2) {
+    data[3 * j] = s0;
+    data[3 * j + 1] = s1;
+    data[3 * j + 2] = s2;
+    double* to = solution + 3 * (permuted ? order[j] : j);
+    to[0] = s0;
+    to[1] = s1;
+    to[2] = s2;
+  };
   for (Eigen::Index j = n - 1; j >= 0; --j) {
+    const int* rows = shared_rows + column_rows[j];
+    const double* column = value + outer[j];
+    const int count = outer[j + 1] - outer[j];
     double s0 = data[3 * j] * inverse_d[j], s1 = data[3 * j + 1] * inverse_d[j], s2 = data[3 * j + 2] * inverse_d[j];
-    for (int p = outer[j], end = outer[j + 1]; p < end; ++p) {
-      const double l = value[p];
-      const double* row = data + 3 * inner[p];
+    if (j > 0 && nests_next[j - 1]) {
+      // Columns j - 1 and j: the common rows for both, then row j for j - 1.
+      const Eigen::Index i = j - 1;
+      const double* previous = value + outer[i] + 1;  // entry k on column j's row k
+      double t0 = data[3 * i] * inverse_d[i], t1 = data[3 * i + 1] * inverse_d[i], t2 = data[3 * i + 2] * inverse_d[i];
+      for (int k = 0; k < count; ++k) {
+        const double a = column[k], c = previous[k];
+        const double* row = data + 3 * rows[k];
+        s0 -= a * row[0];
+        s1 -= a * row[1];
+        s2 -= a * row[2];
+        t0 -= c * row[0];
+        t1 -= c * row[1];
+        t2 -= c * row[2];
+      }
+      const double l = previous[-1];
+      finish(j, s0, s1, s2);
+      finish(i, t0 - l * s0, t1 - l * s1, t2 - l * s2);
+      --j;
+      continue;
+    }
+    for (int k = 0; k < count; ++k) {
+      const double l = column[k];
+      const double* row = data + 3 * rows[k];
       s0 -= l * row[0];
       s1 -= l * row[1];
       s2 -= l * row[2];
     }
-    data[3 * j] = s0;
-    data[3 * j + 1] = s1;
-    data[3 * j + 2] = s2;
+    finish(j, s0, s1, s2);
   }
-  return ldlt_.permutationPinv() * y;
+  return x;
 }
 
 Eigen::VectorXd SpdFactorization::solve(const Eigen::VectorXd& b) const {

@@ -47,7 +47,8 @@ Eigen::VectorXd gather_stacked(const Eigen::Matrix3Xd& values, const MovableMap&
 void scatter_stacked(const Eigen::VectorXd& stacked, const MovableMap& map, Eigen::Matrix3Xd& values);
 
 // Which factorization holds an SpdFactorization's factor.
-//   kSimplicial  Eigen's SimplicialLDLT with an AMD ordering: one column of L at
+//   kSimplicial  Eigen's SimplicialLDLT with an AMD ordering (CHOLMOD's AMD
+//                when the suite has CHOLMOD, else Eigen's): one column of L at
 //                a time. No dependency, and the fastest for small factors.
 //   kSupernodal  CHOLMOD's supernodal LLᵀ (SuiteSparse): columns of L with the
 //                same pattern are grouped into dense blocks factored by the BLAS
@@ -135,10 +136,14 @@ class SpdFactorization {
   const Eigen::SimplicialLDLT<SparseMatrix>& eigen() const;
 
  private:
-  // SimplicialLDLT with its symbolic analysis's column counts readable (the flop count).
+  // SimplicialLDLT with its symbolic analysis's column counts readable (the
+  // flop count), and an analysis in a given fill-reducing order.
   class Ldlt : public Eigen::SimplicialLDLT<SparseMatrix> {
    public:
     double flops() const;
+    // analyzePattern(a) with the order `order` (order[k]: the row of a that
+    // is row k of P a Pᵀ) in place of Eigen's AMD.
+    void analyze_in_order(const SparseMatrix& a, const std::vector<int>& order);
   };
   struct Cholmod;  // CHOLMOD's state (common/sparse.cpp); null unless used
 
@@ -146,11 +151,17 @@ class SpdFactorization {
   bool same_pattern(const SparseMatrix& a) const;
   bool numeric(const SparseMatrix& a);
   bool accept_pivots(Eigen::Index rows);
+  void share_rows();
 
   SpdBackend choice_;
   SpdBackend backend_ = SpdBackend::kSimplicial;
   mutable Ldlt ldlt_;              // supernodal: computed by eigen() on demand
   Eigen::VectorXd inverse_d_;      // simplicial: 1 / D, for solve3
+  // Simplicial, for solve3: column j of L's row indices are
+  // shared_rows_[column_rows_[j] ...] (as many as the column has entries), one
+  // list per run of columns with nested patterns (share_rows).
+  std::vector<int> column_rows_, shared_rows_;
+  std::vector<char> nests_next_;  // per column j: column j + 1's list is j's without its first entry
   mutable bool ldlt_stale_ = false;  // supernodal: ldlt_ is not this factor's
   std::unique_ptr<Cholmod> cholmod_;
   bool ok_ = false;
