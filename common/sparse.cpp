@@ -560,7 +560,7 @@ void SpdFactorization::share_rows() {
   for (int j = 0; j < n; ++j) {
     const int count = outer[j + 1] - outer[j];
     const bool nested = j > 0 && outer[j] - outer[j - 1] == count + 1 && inner[outer[j - 1]] == j &&
-                  std::equal(inner + outer[j], inner + outer[j + 1], inner + outer[j - 1] + 1);
+                        std::equal(inner + outer[j], inner + outer[j + 1], inner + outer[j - 1] + 1);
     if (nested) {
       column_rows_[static_cast<std::size_t>(j)] = column_rows_[static_cast<std::size_t>(j) - 1] + 1;
       nests_next_[static_cast<std::size_t>(j) - 1] = 1;
