@@ -439,6 +439,7 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
   // matrix is analysed once. Below kSmallest rows even a dense factor has
   // fewer than kSupernodalFlops flops (n³/3): Eigen's analysis alone.
   constexpr Eigen::Index kSmallest = 300;
+  std::vector<int> order;  // the simplicial factor's ordering, when CHOLMOD's analysis already made one
   if (choice_ == SpdBackend::kSupernodal || (choice_ == SpdBackend::kAutomatic && matrix->rows() >= kSmallest)) {
     if (!cholmod_) cholmod_ = std::make_unique<Cholmod>();
     if (cholmod_->factor != nullptr) cholmod_free_factor(&cholmod_->factor, &cholmod_->common);
@@ -456,14 +457,16 @@ bool SpdFactorization::factor(const SparseMatrix& a) {
       backend_ = SpdBackend::kSupernodal;
       cholmod_->permute(*matrix);
     } else {
-      cholmod_free_factor(&cholmod_->factor, &cholmod_->common);  // Eigen's, below
+      // Eigen's factor, below, in the order this analysis chose (not a second analysis).
+      const int* perm = static_cast<const int*>(cholmod_->factor->Perm);
+      order.assign(perm, perm + matrix->rows());
+      cholmod_free_factor(&cholmod_->factor, &cholmod_->common);
     }
   }
 #endif
   if (backend_ == SpdBackend::kSimplicial) {
 #ifdef CL_HAVE_CHOLMOD
-    std::vector<int> order;
-    if (cholmod_amd_order(*matrix, order)) {
+    if (!order.empty() || cholmod_amd_order(*matrix, order)) {
       ldlt_.analyze_in_order(*matrix, order);
     } else {
       ldlt_.analyzePattern(*matrix);
