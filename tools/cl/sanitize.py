@@ -6,6 +6,7 @@ import atexit
 from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 import os
+from pathlib import Path
 import signal
 import subprocess
 import sys
@@ -159,15 +160,19 @@ class BackgroundSuite:
             os.killpg(self.process.pid, signal.SIGTERM)
 
     def send(self, number):
-        """Send `number` to the build (its whole process group) or to the programs running."""
+        """Send `number` to the build (its process group, then the compilers
+        ninja runs, each in a group of its own) or to the programs running."""
         if self.process.returncode is None:
             try:
-                os.killpg(self.process.pid, number)
+                os.killpg(self.process.pid, number)  # ninja first: stopped, it starts no compiler
             except ProcessLookupError:
                 pass
-        for process in self.running:
+        # Stopping ninja alone left the compilers it had started running beside
+        # the fuzzers (ninja gives each one a process group of its own).
+        build = descendants(self.process.pid) if self.process.returncode is None else []
+        for pid in [*build, *(process.pid for process in self.running)]:
             try:
-                os.kill(process.pid, number)
+                os.kill(pid, number)
             except ProcessLookupError:
                 pass
 
@@ -208,6 +213,24 @@ class BackgroundSuite:
         if self.error is not None:
             raise self.error
         return self.results
+
+
+def descendants(pid):
+    """The processes under `pid` (children, theirs, ...), from /proc; [] where there is none."""
+    children = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            text = stat.read_text()
+        except OSError:  # ended meanwhile
+            continue
+        parent = int(text[text.rfind(")") + 2:].split()[1])  # after "pid (name) state"
+        children.setdefault(parent, []).append(int(stat.parent.name))
+    found, waiting = [], [pid]
+    while waiting:
+        for child in children.get(waiting.pop(), []):
+            found.append(child)
+            waiting.append(child)
+    return found
 
 
 def run_programs(targets, nice=False, suite=None):
