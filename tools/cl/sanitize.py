@@ -162,14 +162,15 @@ class BackgroundSuite:
     def send(self, number):
         """Send `number` to the build (its process group, then the compilers
         ninja runs, each in a group of its own) or to the programs running."""
+        build = []
         if self.process.returncode is None:
             try:
                 os.killpg(self.process.pid, number)  # ninja first: stopped, it starts no compiler
             except ProcessLookupError:
                 pass
-        # Stopping ninja alone left the compilers it had started running beside
-        # the fuzzers (ninja gives each one a process group of its own).
-        build = descendants(self.process.pid) if self.process.returncode is None else []
+            # Stopping ninja alone left the compilers it had started running
+            # beside the fuzzers (ninja gives each one a process group of its own).
+            build = descendants(self.process.pid)
         for pid in [*build, *(process.pid for process in self.running)]:
             try:
                 os.kill(pid, number)
