@@ -193,7 +193,7 @@ function(add_lab name)
   # chain (NAME_tests) and the reference's (NAME_tests_solution).
   file(GLOB test_sources CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/tests/${name}/*.cpp")
   add_library(${name}_test_objects OBJECT ${test_sources})
-  target_link_libraries(${name}_test_objects PRIVATE Catch2::Catch2 ${closure_support})
+  target_link_libraries(${name}_test_objects PRIVATE cl_catch2 ${closure_support})
   target_compile_definitions(${name}_test_objects PRIVATE ${scene_definition})
   cl_unity_tests(${name}_test_objects)
   cl_test_optimisation(${name}_test_objects)

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "bench/step_residual.h"
 #include "labs/lab06_projective_dynamics/projective_dynamics.h"

@@ -7,11 +7,11 @@
 #include <fstream>
 #include <sstream>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "tests/support/scratch.h"
 
-using Catch::Matchers::Contains;
+using cl::test::ContainsText;
 using Catch::Matchers::StartsWith;
 
 namespace {
@@ -109,8 +109,8 @@ TEST_CASE("bad scenes exit 2 with one line naming file and field", "[common][bad
     const RunResult result = run_scene(rule.text, dir);
     CAPTURE(result.stderr_text);
     CHECK(result.exit_code == 2);
-    CHECK_THAT(result.stderr_text, Contains((dir / "bad.json").string()));
-    CHECK_THAT(result.stderr_text, Contains(rule.field));
+    CHECK_THAT(result.stderr_text, ContainsText((dir / "bad.json").string()));
+    CHECK_THAT(result.stderr_text, ContainsText(rule.field));
     CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
     CHECK_FALSE(fs::exists(dir / "out"));
   }
@@ -129,5 +129,5 @@ TEST_CASE("bad command lines exit 2 with one line", "[common][bad-input]") {
     CHECK(std::count(result.stderr_text.begin(), result.stderr_text.end(), '\n') == 1);
     CHECK_THAT(result.stderr_text, StartsWith("lab01_single_spring"));
   }
-  CHECK_THAT(run_probe(folder, dir).stderr_text, Contains("is a folder, not a scene file"));
+  CHECK_THAT(run_probe(folder, dir).stderr_text, ContainsText("is a folder, not a scene file"));
 }

@@ -9,14 +9,14 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/cli.h"
 #include "common/not_implemented.h"
 #include "common/timer.h"
 #include "tests/support/scene_promises.h"
 
-using Catch::Matchers::Contains;
+using cl::test::ContainsText;
 using Catch::Matchers::EndsWith;
 
 namespace {
@@ -41,7 +41,7 @@ TEST_CASE("not_implemented names the function and the course-relative file", "[c
   } catch (const cl::NotImplemented& error) {
     CHECK(error.function() == "project_distance");
     CHECK(error.file() == "labs/lab01_single_spring/single_spring.cpp");
-    CHECK_THAT(std::string(error.what()), Contains("project_distance is not implemented yet"));
+    CHECK_THAT(std::string(error.what()), ContainsText("project_distance is not implemented yet"));
   }
 }
 
@@ -52,8 +52,8 @@ TEST_CASE("scene names resolve to shipped files, paths stay paths", "[common][cl
     cl::resolve_scene_path("no-such-scene", kLab01Scenes);
     FAIL("an unknown scene name was accepted");
   } catch (const cl::InputError& error) {
-    CHECK_THAT(std::string(error.what()), Contains("no scene named 'no-such-scene'"));
-    CHECK_THAT(std::string(error.what()), Contains("two-particles"));
+    CHECK_THAT(std::string(error.what()), ContainsText("no scene named 'no-such-scene'"));
+    CHECK_THAT(std::string(error.what()), ContainsText("two-particles"));
   }
 }
 
@@ -61,10 +61,10 @@ TEST_CASE("an unknown scene name lists what the lab can load", "[common][cli]") 
   // A lab with scenes of its own lists them; one without (lab 11 runs lab 06's
   // and lab 04's) lists every lab's, by lab, never an empty list.
   CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", kLab01Scenes),
-                    Contains("this lab ships: ") && Contains("two-particles"));
+                    ContainsText("this lab ships: ") && ContainsText("two-particles"));
   CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", cl::lab_scene_dir("lab11_acceleration")),
-                    Contains("lab06_projective_dynamics: ") && Contains("pd-curtain-32") &&
-                        Contains("lab04_pbd: ") && !Contains("ships: )"));
+                    ContainsText("lab06_projective_dynamics: ") && ContainsText("pd-curtain-32") &&
+                        ContainsText("lab04_pbd: ") && !ContainsText("ships: )"));
   CHECK_THROWS_WITH(cl::resolve_scene_path("nosuch", kLab01Scenes, "--sweep-scenes"),
                     Catch::Matchers::StartsWith("--sweep-scenes: no scene named 'nosuch'"));
 }
@@ -132,7 +132,7 @@ TEST_CASE("a range given to a common integer flag replaces the common one", "[co
     cl::CommonOptions options = cl::lab_defaults("two-particles", "pd", {"pd"});
     cl::add_common_options(line, options, cl::kFlagIterations);
     line.get_option("--iterations").range(1, 5);
-    CHECK_THAT(line.app().help(), Contains("[1, 5]") && !Contains("100000000"));
+    CHECK_THAT(line.app().help(), ContainsText("[1, 5]") && !ContainsText("100000000"));
     std::vector<std::string> arguments{"probe", "--iterations", given};
     std::vector<char*> argv;
     for (std::string& argument : arguments) argv.push_back(argument.data());
@@ -190,7 +190,7 @@ TEST_CASE("the check flag loads the scene, says what would run and stops where t
   const Outcome checked = run_modes({"--check", "--out", folder.string()});
   CHECK(checked.code == 0);
   CHECK_FALSE(checked.worked);
-  CHECK_THAT(checked.out, Contains("probe: check: ok, would run two-particles") && Contains("writes " + folder.string()));
+  CHECK_THAT(checked.out, ContainsText("probe: check: ok, would run two-particles") && ContainsText("writes " + folder.string()));
   CHECK(checked.err.empty());
   CHECK_FALSE(std::filesystem::exists(folder));
   // Without --check the same call makes the folder and does the work.
@@ -240,15 +240,15 @@ TEST_CASE("the check line names --method only in a mode that reads it", "[common
     CHECK(code == 0);
     return out.str();
   };
-  CHECK_THAT(check_line({}), Contains(", --method pd"));
-  CHECK_THAT(check_line({"--convergence"}), !Contains("--method"));
+  CHECK_THAT(check_line({}), ContainsText(", --method pd"));
+  CHECK_THAT(check_line({"--convergence"}), !ContainsText("--method"));
 }
 
 TEST_CASE("an unknown option is named and the program's options listed", "[common][cli]") {
   const Outcome unknown = run_modes({"--rho", "0.5"});
   CHECK(unknown.code == 2);
   CHECK_THAT(unknown.err, Catch::Matchers::StartsWith("probe: unknown option --rho (options: ") &&
-                              Contains("--steps") && Contains("--warmup") && Contains("--check"));
+                              ContainsText("--steps") && ContainsText("--warmup") && ContainsText("--check"));
   CHECK(std::count(unknown.err.begin(), unknown.err.end(), '\n') == 1);
 }
 
@@ -277,7 +277,7 @@ TEST_CASE("the dt and steps flags hold the scene's ranges", "[common][cli][limit
   std::string line;
   for (const char* value : {"1e300", "1e-300"}) {
     REQUIRE(std::getline(lines, line));
-    CHECK_THAT(line, Contains("--dt: must be in [1e-9, 10] s (got " + std::string(value) + ")"));
+    CHECK_THAT(line, ContainsText("--dt: must be in [1e-9, 10] s (got " + std::string(value) + ")"));
   }
   CHECK_FALSE(std::getline(lines, line));  // one line each, and none for the range's ends
 }
@@ -336,7 +336,7 @@ TEST_CASE("a lab that does not model colliders refuses a scene with colliders", 
   options.scene = "drape-sphere";  // lab 14's, found by name from any lab
   const std::string lab04 = std::string(CL_SOURCE_DIR) + "/labs/lab04_pbd/scenes";
   CHECK_THROWS_WITH(cl::load_scene_for(options, lab04),
-                    Contains("drape-sphere.json: colliders[0]: this lab does not model colliders"));
+                    ContainsText("drape-sphere.json: colliders[0]: this lab does not model colliders"));
   options.models_colliders = true;
   CHECK(cl::load_scene_for(options, lab04).colliders.size() == 2);
   options.scene = "curtain-8";  // without colliders: nothing new to refuse

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/csv.h"
 #include "common/driver.h"
@@ -92,9 +92,9 @@ TEST_CASE("refuse_run_flags refuses --frames, then --summary, each with its reas
   options.frames = 2;
   options.summary = "s.json";
   CHECK_THROWS_MATCHES(cl::refuse_run_flags(options, "not with a sweep", "a sweep writes a CSV"), cl::InputError,
-                       Catch::Message("--frames: not with a sweep"));
+                       Catch::Matchers::Message("--frames: not with a sweep"));
   CHECK_THROWS_MATCHES(cl::refuse_run_flags(options, "", "a sweep writes a CSV"), cl::InputError,
-                       Catch::Message("--summary: a sweep writes a CSV"));
+                       Catch::Matchers::Message("--summary: a sweep writes a CSV"));
   CHECK_NOTHROW(cl::refuse_run_flags(options, "", ""));
 }
 

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/hierarchy.h"
 #include "common/scene.h"

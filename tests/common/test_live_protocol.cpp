@@ -1,7 +1,7 @@
 // The live mode's protocol (common/live_protocol.h, common/live_server.h's
 // token and Origin checks): every refusal is one line starting "live: " and
 // leaves the command empty; every accepted message carries its values.
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include <cmath>
 #include <filesystem>

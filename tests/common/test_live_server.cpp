@@ -2,7 +2,7 @@
 // handshake's accept key (RFC 6455's own example), frame headers read as
 // declared before any payload (so a frame is refused by its length), and the
 // frames the server writes read back by the same parser.
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include <string>
 

@@ -1,5 +1,5 @@
 // Strain and energy measures on cases with known answers.
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/metrics.h"
 

@@ -4,11 +4,11 @@
 #include <utility>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/scene.h"
 
-using Catch::Matchers::Contains;
+using cl::test::ContainsText;
 using Catch::Matchers::WithinAbs;
 using Catch::Matchers::WithinRel;
 
@@ -99,29 +99,29 @@ TEST_CASE("jitter moves only free particles and keeps generated rest lengths", "
 }
 
 TEST_CASE("each rejection names the field and index", "[common][scene]") {
-  CHECK_THAT(rejection("{"), Contains("test.json: malformed JSON"));
-  CHECK_THAT(rejection(R"({"particles": [], "colour": 1})"), Contains("colour: unknown key"));
-  CHECK_THAT(rejection(R"({"particles": [{"v": [0,0,0]}]})"), Contains("particles[0].x: missing"));
+  CHECK_THAT(rejection("{"), ContainsText("test.json: malformed JSON"));
+  CHECK_THAT(rejection(R"({"particles": [], "colour": 1})"), ContainsText("colour: unknown key"));
+  CHECK_THAT(rejection(R"({"particles": [{"v": [0,0,0]}]})"), ContainsText("particles[0].x: missing"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [0,0,0], "mass": 0}]})"),
-             Contains("particles[1].mass: must be in [1e-12, 1e12] kg (got 0)"));
-  CHECK_THAT(rejection(R"({"particles": [{"x": [0,1e999,0]}]})"), Contains("particles[0].x[1]"));
+             ContainsText("particles[1].mass: must be in [1e-12, 1e12] kg (got 0)"));
+  CHECK_THAT(rejection(R"({"particles": [{"x": [0,1e999,0]}]})"), ContainsText("particles[0].x[1]"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 2}]})"),
-             Contains("springs[0].j: index out of range"));
+             ContainsText("springs[0].j: index out of range"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0.5, "j": 1}]})"),
-             Contains("springs[0].i: must be an integer"));
+             ContainsText("springs[0].i: must be an integer"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 1, "j": 1}]})"),
-             Contains("springs[0]: i and j must differ"));
+             ContainsText("springs[0]: i and j must differ"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "rest": -1}]})"),
-             Contains("springs[0].rest: must be in [0, 1e6] m (got -1)"));
+             ContainsText("springs[0].rest: must be in [0, 1e6] m (got -1)"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}], "springs": [{"i": 0, "j": 1, "stiffness": 0}]})"),
-             Contains("springs[0].stiffness: must be a number in [1e-6, 1e15] N/m or \"inf\" (got 0)"));
+             ContainsText("springs[0].stiffness: must be a number in [1e-6, 1e15] N/m or \"inf\" (got 0)"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [2,0,0]}], "triangles": [{"i": 0, "j": 1, "k": 2}]})"),
-             Contains("triangles[0]: zero rest area"));
+             ContainsText("triangles[0]: zero rest area"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0]}, {"x": [1,0,0]}, {"x": [0,1,0]}], "triangles": [{"i": 0, "j": 1, "k": 0}]})"),
-             Contains("triangles[0]: repeated particle index"));
-  CHECK_THAT(rejection(R"({"chain": {"links": 0}})"), Contains("chain.links"));
-  CHECK_THAT(rejection(R"({"cloth": {"pin": ["middle"]}})"), Contains("cloth.pin[0]: must be one of"));
-  CHECK_THAT(rejection(R"({"chain": {}, "cloth": {}})"), Contains("exactly one of"));
+             ContainsText("triangles[0]: repeated particle index"));
+  CHECK_THAT(rejection(R"({"chain": {"links": 0}})"), ContainsText("chain.links"));
+  CHECK_THAT(rejection(R"({"cloth": {"pin": ["middle"]}})"), ContainsText("cloth.pin[0]: must be one of"));
+  CHECK_THAT(rejection(R"({"chain": {}, "cloth": {}})"), ContainsText("exactly one of"));
 }
 
 TEST_CASE("text nested a million deep is refused without a stack overflow", "[common][scene]") {
@@ -129,9 +129,9 @@ TEST_CASE("text nested a million deep is refused without a stack overflow", "[co
   // when the rejection printed it; a million deep crashed the Release build.
   const std::size_t depth = 1'000'000;
   const std::string text = std::string(depth, '[') + std::string(depth, ']');
-  CHECK_THAT(rejection(text), Contains("nested deeper than 32 levels"));
+  CHECK_THAT(rejection(text), ContainsText("nested deeper than 32 levels"));
   CHECK_THAT(rejection(R"({"particles": [{"x": [0,0,0], "v": [[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[0]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]}]})"),
-             Contains("particles[0].v"));
+             ContainsText("particles[0].v"));
 }
 
 TEST_CASE("rest length 0 is allowed", "[common][scene]") {
@@ -166,27 +166,27 @@ TEST_CASE("colliders are read with their defaults and a unit normal", "[common][
 
 TEST_CASE("each collider rejection names the field and index", "[common][scene]") {
   const std::string start = R"({"particles": [{"x": [0,0,0]}], "colliders": )";
-  CHECK_THAT(rejection(start + R"({}})"), Contains("colliders: must be an array"));
-  CHECK_THAT(rejection(start + R"([{"point": [0,0,0]}]})"), Contains("colliders[0].type: missing"));
-  CHECK_THAT(rejection(start + R"([{"type": "cube"}]})"), Contains("colliders[0].type: must be one of"));
-  CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0]}]})"), Contains("colliders[0].normal: missing"));
+  CHECK_THAT(rejection(start + R"({}})"), ContainsText("colliders: must be an array"));
+  CHECK_THAT(rejection(start + R"([{"point": [0,0,0]}]})"), ContainsText("colliders[0].type: missing"));
+  CHECK_THAT(rejection(start + R"([{"type": "cube"}]})"), ContainsText("colliders[0].type: must be one of"));
+  CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0]}]})"), ContainsText("colliders[0].normal: missing"));
   CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0], "normal": [0,0,0]}]})"),
-             Contains("colliders[0].normal: must not be the zero vector"));
+             ContainsText("colliders[0].normal: must not be the zero vector"));
   CHECK_THAT(rejection(start + R"([{"type": "plane", "point": [0,0,0], "normal": [0,1,0], "radius": 1}]})"),
-             Contains("colliders[0].radius: unknown key"));
+             ContainsText("colliders[0].radius: unknown key"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1},
                                    {"type": "sphere", "centre": [0,0,0], "radius": 0}]})"),
-             Contains("colliders[1].radius: must be in (0, 1e6] m (got 0)"));
+             ContainsText("colliders[1].radius: must be in (0, 1e6] m (got 0)"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,0,0], "radius": 1, "friction": -0.1}]})"),
-             Contains("colliders[0].friction: must be in [0, 1e9] (got -0.1)"));
+             ContainsText("colliders[0].friction: must be in [0, 1e9] (got -0.1)"));
   CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [0,0,0], "radius": 1}]})"),
-             Contains("colliders[0].b: missing"));
+             ContainsText("colliders[0].b: missing"));
   CHECK_THAT(rejection(start + R"([{"type": "capsule", "a": [-1.3e154,0,0], "b": [1.3e154,0,0], "radius": 1}]})"),
-             Contains("colliders[0].a[0]: must be in [-1e6, 1e6] m"));
+             ContainsText("colliders[0].a[0]: must be in [-1e6, 1e6] m"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [1e308,1e308,0], "radius": 1}]})"),
-             Contains("colliders[0].centre[0]: must be in [-1e6, 1e6] m"));
+             ContainsText("colliders[0].centre[0]: must be in [-1e6, 1e6] m"));
   CHECK_THAT(rejection(start + R"([{"type": "sphere", "centre": [0,"a",0], "radius": 1}]})"),
-             Contains("colliders[0].centre[1]: must be a number"));
+             ContainsText("colliders[0].centre[1]: must be a number"));
 }
 
 TEST_CASE("a range prints as a scene or a flag would write it", "[common][scene][limits]") {
@@ -244,7 +244,7 @@ TEST_CASE("a finite number outside its range is refused naming the field and the
   };
   for (const auto& [text, expected] : cases) {
     CAPTURE(text);
-    CHECK_THAT(rejection(text), Contains("test.json: " + expected));
+    CHECK_THAT(rejection(text), ContainsText("test.json: " + expected));
   }
 }
 

@@ -8,7 +8,7 @@
 #include <iterator>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/scene.h"
 #include "tests/support/scene_promises.h"

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/sparse.h"
 

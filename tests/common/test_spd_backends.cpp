@@ -16,7 +16,7 @@
 #include <dlfcn.h>
 
 #include <Eigen/Dense>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/sparse.h"
 

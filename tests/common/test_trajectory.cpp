@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 #include <nlohmann/json.hpp>
 
 #include "common/cli.h"
@@ -19,7 +19,7 @@
 #include "common/trajectory.h"
 #include "tests/support/scratch.h"
 
-using Catch::Matchers::Contains;
+using cl::test::ContainsText;
 
 namespace {
 
@@ -198,7 +198,7 @@ TEST_CASE("the frame loop keeps every N-th frame, the last planned one and the f
     const nlohmann::json header = read_json(output.trajectory_dir + "/trajectory.json");
     REQUIRE(header["frame_count"] == 3);
     CHECK(header["frames"][2]["frame"] == 4);
-    CHECK_THAT(header["frames"][2]["status"].get<std::string>(), Contains("stopped by the test"));
+    CHECK_THAT(header["frames"][2]["status"].get<std::string>(), ContainsText("stopped by the test"));
   }
 }
 
@@ -239,7 +239,7 @@ TEST_CASE("the size cap refuses a run too large and its suggested --frames N fit
     message = error.what();
   }
   CAPTURE(message);
-  REQUIRE_THAT(message, Contains("use --frames N with a larger N ("));
+  REQUIRE_THAT(message, ContainsText("use --frames N with a larger N ("));
   const std::size_t at = message.find("larger N (") + 10;
   const int suggested = std::stoi(message.substr(at));
   CAPTURE(suggested);
@@ -252,7 +252,7 @@ TEST_CASE("a trajectory (--frames) needs --out, checked when the scene is loaded
   cl::CommonOptions options;
   options.scene = "curtain-8";
   options.frames = 2;
-  CHECK_THROWS_WITH(cl::load_scene_for(options, cl::lab_scene_dir("lab04_pbd")), Contains("--frames: needs --out"));
+  CHECK_THROWS_WITH(cl::load_scene_for(options, cl::lab_scene_dir("lab04_pbd")), ContainsText("--frames: needs --out"));
   const cl::test::ScratchDir scratch("trajectory_unused");
   options.out = scratch.file("unused");
   CHECK_NOTHROW(cl::load_scene_for(options, cl::lab_scene_dir("lab04_pbd")));

@@ -3,7 +3,7 @@
 // depend on how the constraint is scaled.
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "single_spring.h"
 #include "tests/support/checks.h"

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "single_spring.h"
 #include "tests/support/checks.h"

@@ -3,7 +3,7 @@
 #include <random>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "single_spring.h"
 #include "tests/support/checks.h"

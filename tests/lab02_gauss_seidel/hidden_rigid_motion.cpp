@@ -4,7 +4,7 @@
 #include <random>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "gauss_seidel.h"
 #include "tests/support/checks.h"

@@ -3,7 +3,7 @@
 #include <numeric>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/metrics.h"
 #include "common/scene.h"

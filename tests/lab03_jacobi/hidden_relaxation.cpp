@@ -3,7 +3,7 @@
 // whole step, on a real cloth and for both averagings.
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/scene.h"
 #include "jacobi.h"

@@ -8,7 +8,7 @@
 #include <random>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/metrics.h"
 #include "common/scene.h"

@@ -12,7 +12,7 @@
 #include <atomic>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/scene.h"
 #include "jacobi.h"

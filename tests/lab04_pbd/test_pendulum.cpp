@@ -3,7 +3,7 @@
 #include <cmath>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "pbd.h"
 #include "tests/support/checks.h"

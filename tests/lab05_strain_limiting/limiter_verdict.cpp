@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/output.h"
 #include "common/scene.h"
@@ -78,7 +78,7 @@ TEST_CASE("a stiff chain held only by the spring limiter keeps the band, goes on
   CHECK(limited.max_energy_rise > limited.energy_scale);
   CHECK(limited.energy_exceeded_step >= 1);
   CHECK(limited.energy_exceeded_step <= scene.steps);
-  CHECK_THAT(limited.energy_exceeded, Catch::Matchers::Contains("total energy rose"));
+  CHECK_THAT(limited.energy_exceeded, cl::test::ContainsText("total energy rose"));
 
   // The same step without the limiter is stopped, and nothing is "exceeded" on top.
   const cl::lab05::RunResult unlimited = run(scene, Limit::kNone, 200, high, low);

@@ -3,7 +3,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "strain_limiting.h"
 

@@ -5,7 +5,7 @@
 #include <random>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "strain_limiting.h"
 #include "tests/support/checks.h"

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "strain_limiting.h"
 #include "triangles.h"

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "projective_dynamics.h"
 #include "test_scenes.h"

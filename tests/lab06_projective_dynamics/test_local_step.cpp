@@ -4,7 +4,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "projective_dynamics.h"
 #include "tests/support/checks.h"

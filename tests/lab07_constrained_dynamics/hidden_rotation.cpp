@@ -6,7 +6,7 @@
 #include <random>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "scenes_for_tests.h"

@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "scenes_for_tests.h"

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <Eigen/Dense>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "scenes_for_tests.h"

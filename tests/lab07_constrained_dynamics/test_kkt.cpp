@@ -5,7 +5,7 @@
 #include <stdexcept>
 
 #include <Eigen/Dense>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "scenes_for_tests.h"

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/scene.h"
 #include "constrained.h"

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <string>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "scenes_for_tests.h"

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "tests/support/checks.h"
 #include "xpbd.h"

@@ -4,7 +4,7 @@
 #include <vector>
 
 #include <Eigen/Eigenvalues>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "pbd.h"
 #include "tests/support/checks.h"

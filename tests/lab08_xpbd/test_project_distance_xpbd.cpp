@@ -8,7 +8,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "single_spring.h"
 #include "xpbd.h"

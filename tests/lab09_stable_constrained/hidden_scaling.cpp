@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "geometric_stiffness.h"
 #include "lab09_scenes.h"

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include <Eigen/Eigenvalues>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "geometric_stiffness.h"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include <Eigen/LU>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained.h"
 #include "geometric_stiffness.h"

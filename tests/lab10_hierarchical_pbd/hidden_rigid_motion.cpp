@@ -7,7 +7,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/hierarchy.h"
 #include "common/scene.h"

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "hpbd.h"
 #include "tests/support/checks.h"

@@ -4,7 +4,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "acceleration.h"
 #include "tests/support/checks.h"

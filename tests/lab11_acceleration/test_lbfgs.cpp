@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 #include <Eigen/Dense>
 
 #include "acceleration.h"

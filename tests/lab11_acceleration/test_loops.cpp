@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "../lab06_projective_dynamics/test_scenes.h"
 #include "accelerated.h"

@@ -4,7 +4,7 @@
 #include <random>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "acceleration.h"
 #include "tests/support/checks.h"

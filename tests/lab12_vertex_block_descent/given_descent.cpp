@@ -4,7 +4,7 @@
 #include <cmath>
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "descent.h"
 #include "scenes.h"

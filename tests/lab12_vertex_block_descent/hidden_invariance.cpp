@@ -3,7 +3,7 @@
 // springs reach their prediction in one sweep.
 #include <random>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "scenes.h"
 #include "simulation.h"

@@ -3,7 +3,7 @@
 #include <random>
 
 #include <Eigen/Eigenvalues>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "scenes.h"
 #include "simulation.h"

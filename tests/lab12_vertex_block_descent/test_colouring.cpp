@@ -3,7 +3,7 @@
 #include <random>
 #include <set>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "scenes.h"
 #include "tests/support/checks.h"

@@ -11,7 +11,7 @@
 #include <atomic>
 #include <vector>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "scenes.h"
 #include "simulation.h"

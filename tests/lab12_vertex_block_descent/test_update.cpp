@@ -6,7 +6,7 @@
 #include <random>
 
 #include <Eigen/Cholesky>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "scenes.h"
 #include "simulation.h"

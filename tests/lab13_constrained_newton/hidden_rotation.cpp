@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include <Eigen/Geometry>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "iteration.h"
 #include "lab13_scenes.h"

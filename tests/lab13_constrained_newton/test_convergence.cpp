@@ -4,7 +4,7 @@
 #include <string>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained_newton.h"
 #include "tests/support/checks.h"

@@ -6,7 +6,7 @@
 #include <limits>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained_newton.h"
 #include "tests/support/checks.h"

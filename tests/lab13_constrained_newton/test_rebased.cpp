@@ -7,7 +7,7 @@
 #include <stdexcept>
 
 #include <Eigen/LU>
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "../lab06_projective_dynamics/simulation.h"
 #include "constrained_newton.h"

@@ -4,7 +4,7 @@
 #include <random>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "constrained_newton.h"
 #include "lab13_scenes.h"

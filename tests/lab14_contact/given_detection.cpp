@@ -6,7 +6,7 @@
 // contact): with both, a converged constrained step can drive the particle to
 // the far tip of the two half-spaces' thin wedge. Also: a particle that starts
 // inside a collider is moved out at load (resolve_initial_penetration).
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/metrics.h"
 #include "contact_step.h"

@@ -1,7 +1,7 @@
 // A 16 x 16 cloth dropped flat on a plane comes to rest with its contact
 // forces summing to its weight; dropped on a sphere, no particle is ever
 // inside a collider.
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact_step.h"
 #include "lab14_scenes.h"

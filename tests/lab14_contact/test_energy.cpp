@@ -2,7 +2,7 @@
 // what the run started with.
 #include <algorithm>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "common/metrics.h"
 #include "common/scene.h"

@@ -2,7 +2,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact.h"
 #include "tests/support/checks.h"

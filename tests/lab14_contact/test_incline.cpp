@@ -6,7 +6,7 @@
 // (the constrained method: 1e-6 by the issue, met to 1e-9 here too).
 #include <cmath>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact_step.h"
 #include "experiments.h"

@@ -3,7 +3,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact.h"
 #include "lab14_scenes.h"

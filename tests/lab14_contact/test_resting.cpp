@@ -2,7 +2,7 @@
 // resting on a plane, one above it, and one moving away from it.
 #include <cmath>
 
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact_step.h"
 #include "lab14_scenes.h"

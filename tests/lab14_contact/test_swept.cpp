@@ -1,7 +1,7 @@
 // The swept test (given detect_contacts on the student's surface_distance and
 // projections): a particle fast enough to pass through a sphere, or a plane,
 // within one step ends the step on the near side.
-#include <catch2/catch.hpp>
+#include "tests/support/catch.h"
 
 #include "contact_step.h"
 #include "lab14_scenes.h"
