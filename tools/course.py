@@ -26,7 +26,9 @@ from cl.view import cmd_view
 USAGE = """\
 usage: ./course COMMAND [ARGS]
 
-  demo [--out DIR]                   every lab's demo with the reference code -> DIR (out/)
+  demo [labNN ...] [--out DIR] [--quick]
+                                     every lab's demo with its reference code -> DIR (out/), its
+                                     views and DIR/index.html; labNN: that lab's demo with your code
   test                               unit tests, grading honesty, demo and plots (CI)
   grade [labNN ...] [-t PATTERN] [-v] [--solutions] [--output FILE]
                                      graded tests (each lab built on its own): Score: X/Y,

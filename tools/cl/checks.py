@@ -312,10 +312,12 @@ def check_views(checks, out, labs):
     """The demo's views and out/index.html: every view written, every link of
     the index resolves."""
     try:
-        views = write_views(out, labs, echo=False)
+        views, refused = write_views(out, labs, echo=False)
     except CourseError as error:
         checks.record(False, f"views of {show(out)}: {error}", error.details)
         return
+    if refused:
+        checks.record(False, f"views of {show(out)}: {len(refused)} trajectories refused", refused[:5])
     index = write_index(out)
     missing = index_links(out)
     # A student release of an early week has no reference that keeps a trajectory.

@@ -9,7 +9,7 @@ import time
 
 from . import grade
 from .base import ROOT, check_tree
-from .labs import lab_dirs
+from .labs import lab_dirs, view_lines
 from .release import advance_release, write_release
 
 
@@ -155,15 +155,32 @@ def check_later_week(checks, tree, ids, week="lab08"):
 
 
 def check_release_demo(checks, tree, week):
-    """./course demo in TREE, the release of `week`: exit 0, the labs with a
-    reference shipped ran (their folders in out/), and one line names the
-    skipped ones, the week's lab first."""
+    """./course demo in TREE, the release of `week`, after a handout-like
+    experiment command has written into out/<week>/ a folder that a `view:`
+    line of its demo.txt names, without a trajectory: exit 0, the labs with a
+    reference shipped ran (their folders in out/), one line names the skipped
+    ones, the week's lab first, and out/index.html names them too. Then
+    `./course demo lab02`, whose code is still the stub: one line says it is
+    not written yet, exit 0."""
+    views = view_lines(week)
+    if views:  # what `./course run labNN --out out/<week>/X` leaves: a CSV, no trajectory.json
+        folder = tree / "out" / week / views[0][0].replace("{out}/", "")
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "per_sweep.csv").write_text("sweep,status\n0,ok\n")
     code, lines = sub_course(tree, "demo")
     shipped = sorted(p.name for p in (tree / "solutions").iterdir() if p.is_dir())
     ran = [lab for lab in shipped if (tree / "out" / lab).is_dir()]
     said = [line for line in lines if "demo skipped for" in line]
-    ok = (code == 0 and ran == shipped and len(said) == 1
+    index = tree / "out" / "index.html"
+    page = index.read_text() if index.is_file() else ""
+    ok = (code == 0 and ran == shipped and len(said) == 1 and f"<b>{week}</b>" in page
           and said[0].strip().startswith(f"demo skipped for {grade.lab_id(week)},"))
-    checks.record(ok, f"release {grade.lab_id(week)}: ./course demo exits {code}, runs "
-                  f"{', '.join(grade.lab_id(lab) for lab in ran) or 'nothing'}, "
-                  f"and names the skipped labs in one line", [] if ok else lines[-12:])
+    checks.record(ok, f"release {grade.lab_id(week)}: ./course demo exits {code} after an experiment wrote "
+                  f"into out/{week}/, runs {', '.join(grade.lab_id(lab) for lab in ran) or 'nothing'}, "
+                  f"and names the skipped labs in one line and in out/index.html", [] if ok else lines[-12:])
+    stub = shipped[-1]
+    code, lines = sub_course(tree, "demo", grade.lab_id(stub), "--quick")
+    said = [line for line in lines if "your code is not written yet" in line]
+    ok = code == 0 and len(said) == 1 and f"<b>{stub}</b>" in index.read_text()
+    checks.record(ok, f"release {grade.lab_id(week)}: ./course demo {grade.lab_id(stub)} on its stub exits {code} "
+                  f"and says in one line that the code is not written yet", [] if ok else lines[-12:])
