@@ -43,7 +43,7 @@ def main(out_dir):
     if not cases:
         return figures.skip("lab01_projection", f"needs {lab_dir}/SCENE/positions.csv and springs.csv; make them "
                             "with: " + figures.make_command(LAB, f"--scene triangle --out {lab_dir}/triangle")
-                            + " (every scene: ./course demo)")
+                            + " (every scene: ./course demo lab01)")
     target = lab_dir / "projection_before_after.png"
     if figures.up_to_date(target, [c / name for c in cases for name in ("positions.csv", "springs.csv")]):
         return 0

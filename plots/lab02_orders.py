@@ -96,7 +96,7 @@ def main(out_dir):
     if not runs:
         return figures.skip("lab02_orders", f"needs {lab_dir}/chain-forward.json and chain-forward/convergence.csv "
                             f"(and the other order runs of labs/lab02_gauss_seidel/demo.txt); make them with: "
-                            f"./course demo --out {out_dir}")
+                            f"./course demo lab02 --out {out_dir}")
     sources = [path for name in runs for path in (lab_dir / f"{name}.json", *(lab_dir / name).glob("*.csv"))]
     for target, draw in ((lab_dir / "lab02_orders.png",
                           lambda path: convergence_figure(runs, "sweep", "sweep", 1.0, path)),

@@ -119,7 +119,7 @@ def main(out_dir):
     if not any(load(lab_dir, prefix) for prefix, _ in SCENES):
         return figures.skip("lab03_convergence", f"needs {lab_dir}/chain-gs.json and chain-gs/convergence.csv (and "
                             f"the other chain-*/cloth-* runs of labs/lab03_jacobi/demo.txt); make them with: "
-                            f"./course demo --out {out_dir}")
+                            f"./course demo lab03 --out {out_dir}")
     sources = [path for summary in lab_dir.glob("*.json") for path in (summary, summary.with_suffix("") / "convergence.csv")]
     for target, draw in ((lab_dir / "lab03_gs_vs_jacobi.png",
                           lambda path: comparison_figure(lab_dir, "sweep", "sweep", 1.0, path)),

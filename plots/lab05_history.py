@@ -11,7 +11,7 @@ from _figures import plt
 
 LAB = "lab05_strain_limiting"
 COMMAND = figures.make_command(LAB, "--scene stiff-curtain-32 --limit springs "
-                               "--out out/lab05_strain_limiting/stiff-springs (or ./course demo)")
+                               "--out out/lab05_strain_limiting/stiff-springs (or ./course demo lab05)")
 
 
 def draw(source, summary, target):

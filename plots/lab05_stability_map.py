@@ -17,7 +17,7 @@ from _figures import plt
 
 LAB = "lab05_strain_limiting"
 COMMAND = figures.make_command(LAB, "--scene map-curtain-16 --stability-map --out out/lab05_strain_limiting "
-                               "(or ./course demo)")
+                               "(or ./course demo lab05)")
 COLOURS = {"stable": "#5fae5f", "bounded by the limiter": "#5b8fd6", "blew up": "#d65b5b"}
 
 

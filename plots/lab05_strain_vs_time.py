@@ -16,7 +16,7 @@ from _figures import plt
 LAB = "lab05_strain_limiting"
 COMMAND = figures.make_command(LAB, "--scene soft-curtain-32 --compare-limits "
                                "none,springs,triangles-area,triangles-stretch --steps 800 "
-                               "--out out/lab05_strain_limiting (or ./course demo)")
+                               "--out out/lab05_strain_limiting (or ./course demo lab05)")
 
 
 def draw_strain(series, table, target):

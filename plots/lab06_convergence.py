@@ -13,7 +13,7 @@ from _figures import plt
 
 LAB = "lab06_projective_dynamics"
 COMMAND = figures.make_command(LAB, "--convergence --sweep-scenes pd-curtain-16,pd-curtain-32,pd-curtain-64,"
-                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo)")
+                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo lab06)")
 FLOOR = 1e-17  # an error of exactly 0 (the reference itself) is drawn here
 STYLE = {"pd": {"color": "tab:blue", "label": "projective dynamics (1 factorization)"},
          "newton": {"color": "tab:red", "marker": "o", "markersize": 3,

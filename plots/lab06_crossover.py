@@ -14,7 +14,7 @@ from _figures import plt
 
 LAB = "lab06_projective_dynamics"
 COMMAND = figures.make_command(LAB, "--convergence --sweep-scenes pd-curtain-16,pd-curtain-32,pd-curtain-64,"
-                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo)")
+                               "pd-curtain-128 --out out/lab06_projective_dynamics (or ./course demo lab06)")
 
 
 def figure(rows, path):

@@ -11,7 +11,7 @@ from _figures import plt
 
 LAB = "lab06_projective_dynamics"
 COMMAND = figures.make_command(LAB, "--scene pd-curtain-32 --out out/lab06_projective_dynamics/curtain-32-pd "
-                               "(or ./course demo)")
+                               "(or ./course demo lab06)")
 
 
 def draw(rows, title, path):

@@ -10,7 +10,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab07_constrained_dynamics"
-MAKE = ("./course demo   (or: ./course run lab07 --scene ragdoll-chain-20 --compare-pbd 1,2,4,8,16,32,64,128,256 "
+MAKE = ("./course demo lab07   (or: ./course run lab07 --scene ragdoll-chain-20 --compare-pbd 1,2,4,8,16,32,64,128,256 "
         "--compare-substeps 1,2,4,8,16,32 --out OUT/lab07_constrained_dynamics)")
 
 

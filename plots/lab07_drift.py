@@ -16,7 +16,7 @@ RUNS = [
     ("drift-stabilized", "dt = 1/60 s + projection (--stabilize)"),
     ("drift-dt4", "dt = 1/240 s"),
 ]
-MAKE = ("./course demo   (or: ./course run lab07 --scene ragdoll-chain-20 [--stabilize | "
+MAKE = ("./course demo lab07   (or: ./course run lab07 --scene ragdoll-chain-20 [--stabilize | "
         "--dt 0.004166666666666667 --steps 1200] --out OUT/lab07_constrained_dynamics/RUN)")
 
 

@@ -14,7 +14,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab09_stable_constrained"
-COMMAND = "./course demo (or ./course run lab09 --sweep-mass-ratios 1,10,100,1000,10000,100000,1000000 --out out/lab09_stable_constrained)"
+COMMAND = "./course demo lab09 (or ./course run lab09 --sweep-mass-ratios 1,10,100,1000,10000,100000,1000000 --out out/lab09_stable_constrained)"
 STYLE = {"off": ("tab:red", "without K_g (lab 07)"), "on": ("tab:blue", "with K_g")}
 
 

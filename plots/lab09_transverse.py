@@ -13,7 +13,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab09_stable_constrained"
-COMMAND = "./course demo (or ./course run lab09 --scene heavy-chain-1000 --out out/lab09_stable_constrained/heavy-chain-1000-on)"
+COMMAND = "./course demo lab09 (or ./course run lab09 --scene heavy-chain-1000 --out out/lab09_stable_constrained/heavy-chain-1000-on)"
 FLOOR = 1e-17  # log axes: exact zeros drawn here
 
 

@@ -13,7 +13,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--converge --sweep-scenes flat-curtain-32,flat-curtain-64 "
+COMMAND = ("./course demo lab10  (or: " + figures.make_command(LAB, "--converge --sweep-scenes flat-curtain-32,flat-curtain-64 "
            "--sweep-levels 1,2,3,4 --iterations-per-level 4 --out out/lab10_hierarchical_pbd)"))
 
 

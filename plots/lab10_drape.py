@@ -9,7 +9,7 @@ from _figures import plt
 import _lab04_mesh as mesh  # the OBJ reader and the camera of lab 04's pictures
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--scene drape-32 --levels 3 --iterations-per-level 12 "
+COMMAND = ("./course demo lab10  (or: " + figures.make_command(LAB, "--scene drape-32 --levels 3 --iterations-per-level 12 "
                                                       "--steps 150 --frames 15 "
                                                       "--out out/lab10_hierarchical_pbd/drape-levels-3") + ")")
 

@@ -9,7 +9,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab10_hierarchical_pbd"
-COMMAND = ("./course demo  (or: " + figures.make_command(LAB, "--scene flat-curtain-64 --levels 3 "
+COMMAND = ("./course demo lab10  (or: " + figures.make_command(LAB, "--scene flat-curtain-64 --levels 3 "
            "--iterations-per-level 12 --steps 180 --out out/lab10_hierarchical_pbd/equal-cost-levels-3 "
            "--summary out/lab10_hierarchical_pbd/equal-cost-levels-3.json)"))
 

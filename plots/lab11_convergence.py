@@ -16,7 +16,7 @@ import _figures as figures
 from _figures import plt
 
 LAB = "lab11_acceleration"
-COMMAND = ("./course demo  (or: " + figures.make_command(
+COMMAND = ("./course demo lab11  (or: " + figures.make_command(
     LAB, "--convergence --scene pd-curtain-32 --method pd-chebyshev --out out/lab11_acceleration/chebyshev") + ")")
 FLOOR = 1e-17  # an error of exactly 0 is drawn here
 PBD = {"jacobi", "jacobi-chebyshev", "gauss-seidel"}

@@ -45,7 +45,7 @@ def read_runs(paths):
 
 def lab11_hint(out_dir, scene):
     """Where lab 11's curves for `scene` come from: its demo, or the line of it for this scene."""
-    return (f"PD, Chebyshev PD, L-BFGS and Newton need lab 11's run: ./course demo, or "
+    return (f"PD, Chebyshev PD, L-BFGS and Newton need lab 11's run: ./course demo lab11, or "
             + figures.make_command(OTHER, f"--scene {scene} --convergence --method pd-chebyshev --iterations 3000 "
                                    f"--out {out_dir / OTHER}/exp1/chebyshev") + " (and --method pd, pd-lbfgs, newton)")
 
@@ -78,7 +78,7 @@ def main(out_dir):
     if not tables:
         return figures.skip("lab12_convergence", f"no convergence.csv under {lab_dir}; make one with " +
                             figures.make_command(LAB, f"--convergence --scene pd-curtain-32 --method vbd "
-                                                 f"--iterations 3000 --out {lab_dir}/exp1/vbd") + " (or ./course demo)")
+                                                 f"--iterations 3000 --out {lab_dir}/exp1/vbd") + " (or ./course demo lab12)")
     other_dir = out_dir / OTHER
     others = sorted(other_dir.rglob("convergence.csv")) if other_dir.is_dir() else []
     ours = read_runs(tables)
@@ -92,7 +92,7 @@ def main(out_dir):
             figures.skip("lab12_convergence", f"{target.name}: no lab 11 curves for {scene}; "
                          + lab11_hint(out_dir, scene))
             missing = (f"No PD, Chebyshev PD, L-BFGS or Newton curve: they come from lab 11's run of {scene} "
-                       "(./course demo, or the --convergence lines of labs/lab11_acceleration/demo.txt)")
+                       "(./course demo lab11, or the --convergence lines of labs/lab11_acceleration/demo.txt)")
         draw(scene, {**theirs.get(scene, {}), **curves}, target, missing)
     return 0
 

@@ -90,7 +90,7 @@ def main(out_dir):
     if not tables:
         return figures.skip("lab13_convergence", f"no crossover.csv under {lab_dir}; make one with " +
                             figures.make_command(LAB, f"--convergence --sweep-scenes pd-curtain-16 "
-                                                 f"--out {lab_dir}/exp1") + " (or ./course demo)")
+                                                 f"--out {lab_dir}/exp1") + " (or ./course demo lab13)")
     for crossover in tables:
         convergence = crossover.with_name("convergence.csv")
         sources = [crossover] + ([convergence] if convergence.is_file() else [])

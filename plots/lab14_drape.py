@@ -92,7 +92,7 @@ def main(out_dir):
     histories = sorted(lab_dir.glob("drape-*/per_step.csv")) if lab_dir.is_dir() else []
     if not tables and not histories:
         return figures.skip("lab14_drape", f"no drape.csv or drape-*/per_step.csv under {lab_dir}; make one with " +
-                            figures.make_command(LAB, f"--drape --out {lab_dir}/exp1") + " (or ./course demo)")
+                            figures.make_command(LAB, f"--drape --out {lab_dir}/exp1") + " (or ./course demo lab14)")
     for table in tables:
         target = table.with_name("drape.png")
         if not figures.up_to_date(target, [table]):

@@ -45,7 +45,7 @@ def main(out_dir):
     tables = sorted(lab_dir.rglob("incline.csv")) if lab_dir.is_dir() else []
     if not tables:
         return figures.skip("lab14_incline", f"no incline.csv under {lab_dir}; make one with " +
-                            figures.make_command(LAB, f"--incline --out {lab_dir}/exp2") + " (or ./course demo)")
+                            figures.make_command(LAB, f"--incline --out {lab_dir}/exp2") + " (or ./course demo lab14)")
     for table in tables:
         target = table.with_name("incline.png")
         if not figures.up_to_date(target, [table]):

@@ -79,6 +79,19 @@ def quiet(command, what):
                           details=done.stdout.splitlines())
 
 
+def defined_targets(build_dir=None):
+    """The targets this build defines (a week's tree defines no trade, extremes
+    or bench_* whose references it has not got); None when it cannot tell."""
+    build_dir = build_dir or BUILD
+    if not uses_ninja(build_dir):
+        return None
+    done = subprocess.run(["ninja", "-C", str(build_dir), "-t", "targets", "all"], capture_output=True,
+                          text=True, check=False)
+    if done.returncode != 0:
+        return None
+    return {line.split(":", 1)[0].rsplit("/", 1)[-1] for line in done.stdout.splitlines()}
+
+
 def build_command(targets, build_dir, keep_going=False):
     """The command that builds `targets` in build_dir on both cores (keep_going: past a failure)."""
     command = ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets]

@@ -26,15 +26,17 @@ from pathlib import Path
 from . import grade
 from .base import BIN, ROOT, CourseError
 from .build import BuildFailure, build_targets, configure
-from .labs import lab_dirs, manifest, resolve_lab
+from .demo import demo_folders
+from .labs import demo_lines, lab_dirs, manifest, resolve_lab
+from .release import is_release
 
 # Commands that need every lab's reference or the instructor's tree: a handout
 # shows them only as the instructor's (the word within INSTRUCTOR_LINES above).
 INSTRUCTOR_COMMANDS = {"bench", "extremes", "fuzz", "sanitize", "release", "autograder"}
 INSTRUCTOR_PROGRAMS = re.compile(r"^(trade|extremes|bench_\w+)$")
 INSTRUCTOR_LINES = 4
-STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view", "handouts", "claims"}
-INSTRUCTOR_COMMANDS |= {"mistakes"}
+STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view", "claims"}
+INSTRUCTOR_COMMANDS |= {"mistakes", "handouts"}
 # A usage line, not a command: a placeholder in capitals (DIR, PATTERN, ARGS) or labNN.
 TEMPLATE = re.compile(r"\b(labNN\w*|[A-Z]{2,}[A-Z0-9_]*)\b|…|\.\.\.")
 COMMAND = re.compile(r"^(\./course\s|build/bin/|lab\d\d_[a-z0-9_]+\s)")
@@ -151,6 +153,7 @@ class PageChecker:
     def __init__(self, week):
         self.week = Week(week)
         self.outs = []  # (folder, with --frames) written by earlier commands, relative to ROOT
+        self.demo_out = None  # where an earlier plain `./course demo` wrote
 
     def check(self, command):
         try:
@@ -220,6 +223,49 @@ class PageChecker:
                 return f"-t {args.t}: matches no graded case of {token}"
         return None
 
+    def check_demo(self, rest):
+        """`./course demo` writes out/labMM_name/ for the labs with a reference
+        in the week (MM < NN); `./course demo labMM` that lab's with the
+        student's code, each of its demo.txt runs checked (--check)."""
+        parser = argparse.ArgumentParser(add_help=False)
+        parser.add_argument("labs", nargs="*")
+        parser.add_argument("--out", default="out")
+        parser.add_argument("--quick", action="store_true")
+        try:
+            args = parser.parse_args(rest)
+        except SystemExit:
+            return "./course demo refuses these arguments"
+        if not args.labs:
+            self.demo_out = Path(args.out)
+            return None
+        for token in args.labs:
+            program, why = self.week.program(token)
+            if why:
+                return why
+            lab = resolve_lab(token.removesuffix("_solution"))
+            if not demo_lines(lab):
+                return f"{token} has no demo (labs/{lab}/demo.txt)"
+            lab_out = Path(args.out) / lab
+            for line in demo_lines(lab):
+                problem = check_program(program, [a.replace("{out}", str(lab_out)) for a in line])
+                if problem:
+                    return f"labs/{lab}/demo.txt: {shlex.join(line)}: {problem}"
+            self.outs.append((lab_out, False))
+            self.outs += [(lab_out / folder, True) for folder in demo_folders(lab, frames_only=True)]
+        return None
+
+    def demo_writes(self, folder, frames=False):
+        """True for a folder that `./course demo`, shown earlier on the page,
+        fills in this week: out/ itself, or out/labMM_name/... of a lab with
+        a reference in the week (MM < NN), a folder its demo.txt writes
+        (with frames: one that keeps a trajectory)."""
+        if self.demo_out is None or folder == self.demo_out:
+            return folder == self.demo_out
+        parts = folder.relative_to(self.demo_out).parts if is_under(folder, self.demo_out) else ()
+        if not parts or not re.fullmatch(r"lab\d\d_\w+", parts[0]) or lab_number(parts[0]) >= self.week.week:
+            return False
+        return not frames or "/".join(parts[1:]) in demo_folders(parts[0], frames_only=True)
+
     def check_plots(self, rest):
         targets = [t for t in rest if not t.startswith("-")]
         labs = [t for t in targets if re.fullmatch(r"lab\d\d(_\w+)?", t)]
@@ -230,9 +276,11 @@ class PageChecker:
         else:
             roots = [folder / resolve_lab(lab) for lab in labs] or [folder]
         for root in roots:
-            if not any(is_under(out, root) for out, _ in self.outs) and not demo_writes(root):
-                return (f"./course plots reads {root}/, where no earlier command of this page writes "
-                        f"(give --out {root}/... or point plots at the folder)")
+            if not any(is_under(out, root) or is_under(root, out) for out, _ in self.outs) \
+                    and not self.demo_writes(root):
+                return (f"./course plots reads {root}/, where no earlier command of this page writes in "
+                        f"week {self.week.week:02d}'s tree (give --out {root}/..., or ./course demo "
+                        f"lab{self.week.week:02d} first)")
         return None
 
     def check_view(self, rest):
@@ -244,19 +292,14 @@ class PageChecker:
                 continue
             folders.append(Path(word))
         for folder in folders:
-            if not any(out == folder and frames for out, frames in self.outs) and not demo_writes(folder):
+            if not any(out == folder and frames for out, frames in self.outs) \
+                    and not self.demo_writes(folder, frames=True):
                 return f"./course view {folder}: no earlier command of this page writes a trajectory there (--frames N --out {folder})"
         return None
 
 
 def is_under(path, root):
     return path == root or root in path.parents
-
-
-def demo_writes(folder):
-    """True for the folders ./course demo fills (out/ and out/labNN_name/...)."""
-    return folder == Path("out") or (len(folder.parts) >= 2 and folder.parts[0] == "out"
-                                     and re.fullmatch(r"lab\d\d_\w+", folder.parts[1]) is not None)
 
 
 _CASES = {}
@@ -318,6 +361,12 @@ def cmd_handouts(argv):
     parser.add_argument("labs", nargs="*", metavar="labNN", help="the labs (default: all, and README.md)")
     args = parser.parse_args(argv)
     labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
+    if is_release():
+        # It checks every week's tree from the instructor's (every reference,
+        # the bench's programs): as ./course bench, one line, exit 2.
+        raise CourseError("./course handouts is the instructor's: it checks each handout against its week's "
+                          "tree from the instructor's, which holds every lab's reference and the bench's "
+                          "programs (this is a student release)", code=2)
     configure()
     try:
         build_targets(needed_targets(labs), log=None)

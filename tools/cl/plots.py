@@ -175,7 +175,7 @@ def cmd_plots(argv):
     args = parser.parse_args(argv)
     directory, prefixes = parse_targets(args.targets)
     if not directory.is_dir():
-        raise CourseError(f"{show(directory)} is not a directory (make it with ./course demo)", code=2)
+        raise CourseError(f"{show(directory)} is not a directory (make it with ./course demo labNN, or a run's --out)", code=2)
     if not plot_scripts(prefixes):
         print("no plot scripts in plots/ yet" if prefixes is None else
               f"no plot scripts in plots/ for {', '.join(prefixes)}")
