@@ -2,7 +2,6 @@
 // gauss-seidel, lab 02's sweeps in file order, for the side-by-side
 // comparison), with the strain error, the change in positions and the wall
 // time of every sweep. Divergence (ω ≥ 2) is a reported outcome, not a failure.
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +14,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/openmp.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "common/timer.h"
@@ -53,7 +53,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("%s: scene %s, %ld particles, %zu springs, %d ", kLab, scene.name.c_str(),
               static_cast<long>(scene.particles.size()), spring_count, options.iterations);
   if (jacobi) {
-    omp_set_num_threads(lab.threads);
+    cl::set_openmp_threads(lab.threads);
     std::printf("Jacobi sweeps (omega %g, %s, %d thread%s)\n", lab.omega,
                 averaging == cl::lab03::Averaging::kByCount ? "averaged by count" : "summed, no averaging",
                 lab.threads, lab.threads == 1 ? "" : "s");
@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
                              cl::kFlagFrames);
   app.get_option("--iterations").description("sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
-  lab.threads = omp_get_max_threads();
+  lab.threads = cl::openmp_max_threads();
   app.add_option("--omega", lab.omega, "Jacobi relaxation factor (0 leaves x unchanged; >= 2 diverges)")
       .non_negative()
       .capture_default_str();

@@ -23,6 +23,20 @@ using Catch::Approx;
 #include "tests/support/catch.h"
 #endif
 
+// Ends the running case as skipped, saying why: Catch2 3.3's SKIP; where there
+// is none (2.13, 3.0-3.2), a warning, and the case ends without a failure. The
+// grader skips such cases itself where it knows they cannot run (tools/cl/grade.py:
+// the cases tagged [openmp] in a build without OpenMP).
+#ifdef SKIP
+#define CL_SKIP(why) SKIP(why)
+#else
+#define CL_SKIP(why) \
+  do {               \
+    WARN(why);       \
+    return;          \
+  } while (false)
+#endif
+
 namespace cl::test {
 
 // A string matcher: the text contains `text`, case-sensitively.
