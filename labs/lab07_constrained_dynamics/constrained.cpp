@@ -72,7 +72,7 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
   not_implemented("solve_kkt", __FILE__);
 }
 
-// TODO(lab07.4) [5 pts] The Schur-complement solve:
+// TODO(lab07.4) [6 pts] The Schur-complement solve:
 //     S = Δt² J W Jᵀ + C               (m × m; W = diag(step.inv_mass))
 //     S λ = −φ − ΔtJ(v + Δt g)
 //     v_new = v + Δt g + Δt W Jᵀ λ
@@ -81,18 +81,21 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns) 
 // v_new = v + Δt g and an empty λ. Check the step as kkt_system does.
 // Graded by tests/lab07_constrained_dynamics/test_spring.cpp (a 1-D spring in
 // closed form, 1), test_agreement.cpp (a dense solve of the KKT system on
-// random scenes, 2) and test_redundant.cpp (2).
+// random scenes, 2), test_redundant.cpp (2) and test_update.cpp (no
+// constraint, and the refusals, 1).
 StepSolution solve_schur(const LinearizedStep& step) {
   (void)step;
   not_implemented("solve_schur", __FILE__);
 }
 
-// TODO(lab07.5) [3 pts] The update: v ← v_new for every movable particle
+// TODO(lab07.5) [4 pts] The update: v ← v_new for every movable particle
 // (scatter `velocity` over map's unknowns), v = 0 for a pinned one, then
 // x ← x + Δt v. Throw std::invalid_argument before changing anything when dt
 // is not finite or ≤ 0 or the sizes disagree (velocity must have 3u entries).
 // Graded by tests/lab07_constrained_dynamics/test_physics.cpp (C = 0 meets
-// the linearised constraint, the hanging bead, the pendulum's period).
+// the linearised constraint, the hanging bead, the pendulum's period: 3) and
+// test_update.cpp (the update alone: x moves by the new v, a pin's v is 0,
+// refusals change nothing: 1).
 void update_positions(Particles& particles, const MovableMap& map, const Eigen::VectorXd& velocity, double dt) {
   (void)particles, (void)map, (void)velocity, (void)dt;
   not_implemented("update_positions", __FILE__);
