@@ -9,7 +9,7 @@
 
 namespace cl::lab05 {
 
-// TODO(lab05.1) [7 pts] Limit one spring's strain σ = ‖x_i − x_j‖ / L to [σ_min, σ_max].
+// TODO(lab05.1) [8 pts] Limit one spring's strain σ = ‖x_i − x_j‖ / L to [σ_min, σ_max].
 // Check the arguments (inverse masses finite and >= 0, L finite and > 0,
 // 0 < σ_min <= σ_max, both finite) and throw std::invalid_argument otherwise.
 // Compute σ and σ₀ = clamp(σ, σ_min, σ_max); inside the band return zeros.
@@ -18,7 +18,7 @@ namespace cl::lab05 {
 // — lab 01's project_distance with rest length σ₀L does exactly this. Both
 // ends pinned or coincident particles: zeros.
 // Graded by tests/lab05_strain_limiting/test_limit_spring.cpp (4 pts) and
-// test_runs.cpp (3 pts: your limiter inside the given step), and with lab05.2
+// test_runs.cpp (4 pts: your limiter inside the given step), and with lab05.2
 // and lab05.3 by test_invalid_arguments.cpp (1 pt).
 lab01::DistanceCorrection limit_spring(const Eigen::Vector3d& x_i, const Eigen::Vector3d& x_j, double inv_mass_i,
                                        double inv_mass_j, double rest_length, double sigma_min, double sigma_max) {
@@ -39,7 +39,7 @@ Eigen::Matrix3d limit_triangle_area(const Eigen::Matrix3d& corners, const Eigen:
   not_implemented("limit_triangle_area", __FILE__);
 }
 
-// TODO(lab05.3) [4 pts] Limit a triangle's principal stretches to [σ_min, σ_max].
+// TODO(lab05.3) [5 pts] Limit a triangle's principal stretches to [σ_min, σ_max].
 // Same weights and no-op cases as lab05.2; also throw std::invalid_argument
 // when rest.shape (D_m) or rest.inverse_shape (D_m⁻¹) is not finite: both are
 // used. Build the frame B (triangle_frame),

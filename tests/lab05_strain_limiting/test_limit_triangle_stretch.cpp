@@ -1,6 +1,7 @@
 // Graded tests for lab05.3, limit_triangle_stretch: the singular values of the
 // new F in the band, the centroid and the rotation of F kept, and a turned-over
-// and a zero-area triangle handled as strain_limiting.h says.
+// and a zero-area triangle handled as strain_limiting.h says, and two or three
+// pinned corners left alone.
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -152,6 +153,26 @@ TEST_CASE("the stretch limit handles a turned-over and a zero-area triangle as t
   for (const Matrix3d& corners : {collinear, two_coincident, all_coincident}) {
     CAPTURE(corners);
     const Matrix3d zero = cl::lab05::limit_triangle_stretch(corners, inv_mass, rest, 0.9, 1.1);
+    REQUIRE(zero == Matrix3d::Zero());
+  }
+}
+
+TEST_CASE("the stretch limit leaves a triangle with two or three pinned corners alone", "[lab05][pts=1]") {
+  // The weights ω = (w_j w_k, w_i w_k, w_i w_j) then sum to 0: no centroid to
+  // scale about, and nothing a limiter may move (a curtain pinned along its
+  // top row has such triangles). Stretched 1.6 × far outside the band, so
+  // only that rule returns zeros here.
+  Matrix3d rest_corners;
+  rest_corners << 0, 1, 0,  //
+      0, 0, 1,              //
+      0, 0, 0;
+  const cl::lab05::TriangleRest rest = cl::lab05::make_triangle_rest(rest_corners);
+  Matrix3d stretched = rest_corners;
+  stretched.row(0) *= 1.6;
+  for (const Vector3d& inv_mass : {Vector3d(0, 0, 1), Vector3d(0, 2, 0), Vector3d(0.5, 0, 0), Vector3d(0, 0, 0)}) {
+    CAPTURE(inv_mass.transpose(), stretched);
+    const Matrix3d zero = cl::lab05::limit_triangle_stretch(stretched, inv_mass, rest, 0.9, 1.1);
+    CAPTURE(zero);
     REQUIRE(zero == Matrix3d::Zero());
   }
 }
