@@ -31,6 +31,11 @@ from .release import course_files
 TREE = BUILD / "mistakes-tree" / "course"
 CASE_TIMEOUT = 120
 MARKER = re.compile(r"<!--\s*mistake:\s*([\w-]+)\s*-->")
+ADVICE = re.compile(r"<!--\s*advice\s*-->")  # an entry of advice: no mistake, no symptom to check
+ENTRY_SECTIONS = re.compile(r"^#+ .*(troubleshooting|messages)", re.IGNORECASE)
+# Issue 66: labs 03 and 10's entries are being catalogued on their own branch;
+# this check takes them once they are marked.
+NOT_YET_MARKED = {"lab03_jacobi", "lab10_hierarchical_pbd"}
 
 
 def catalogue(lab):
@@ -237,14 +242,57 @@ def plant_round(plants, every_case, log, lines):
     return caught
 
 
+def handout_entries(page):
+    """(line, text) of each entry of a handout's Troubleshooting and Messages
+    sections: a list item (`- ` and its indented lines), with the comment
+    lines just above it (a marker may stand there or inside the item)."""
+    entries, current, above = [], None, ""
+    inside = False
+    for number, line in enumerate(page.splitlines(), 1):
+        if line.startswith("#"):
+            inside, current, above = bool(ENTRY_SECTIONS.match(line)), None, ""
+        elif not inside:
+            continue
+        elif line.startswith("- "):
+            current = [number, above + line]
+            entries.append(current)
+            above = ""
+        elif line.startswith("<!--") and line.rstrip().endswith("-->"):
+            current, above = None, above + line + " "
+        elif current is not None and line.startswith(" ") and line.strip():
+            current[1] += " " + line.strip()
+        else:
+            current = None
+    return [tuple(entry) for entry in entries]
+
+
+def unmarked_entries(lab):
+    """The handout's Troubleshooting and Messages entries that are neither a
+    catalogued mistake (<!-- mistake: ID -->, whose symptom ./course mistakes
+    checks) nor marked <!-- advice --> (no symptom to check), or are both."""
+    if lab in NOT_YET_MARKED:
+        return []
+    path = ROOT / "labs" / lab / "README.md"
+    problems = []
+    for line, text in handout_entries(path.read_text()):
+        kinds = len(MARKER.findall(text)) + len(ADVICE.findall(text))
+        if kinds != 1:
+            words = " ".join(re.sub(r"<!--.*?-->", "", text).split()[1:9])
+            problems.append(f"  FAIL labs/{lab}/README.md:{line}: an entry with {kinds} markers, not one "
+                            f"(<!-- mistake: ID --> or <!-- advice -->): {words} ...")
+    return problems
+
+
 def troubleshooting_gaps(lab, entries):
-    """Markers in the handout without an entry, and entries marked as
-    Troubleshooting whose marker is not in the handout."""
+    """Markers in the handout without an entry, entries marked as
+    Troubleshooting whose marker is not in the handout, and handout entries
+    that are neither (unmarked_entries)."""
     page = (ROOT / "labs" / lab / "README.md").read_text()
     marked = set(MARKER.findall(page))
     ids = {entry["id"] for entry in entries}
-    gaps = [f"  FAIL the handout marks '{m}', which solutions/{lab}/mistakes.json does not have"
-            for m in sorted(marked - ids)]
+    gaps = unmarked_entries(lab)
+    gaps += [f"  FAIL the handout marks '{m}', which solutions/{lab}/mistakes.json does not have"
+             for m in sorted(marked - ids)]
     for entry in entries:
         if entry.get("troubleshooting") and entry["id"] not in marked:
             gaps.append(f"  FAIL {entry['id']}: a Troubleshooting entry, not marked <!-- mistake: {entry['id']} -->")
