@@ -49,7 +49,9 @@
 #
 # The build writes ${PROJECT_BINARY_DIR}/labs.json, read by tools/course.py: per
 # lab its student files, whether it has a reference, its earlier labs and
-# whether the graded tests link each one's reference or the student's code.
+# whether the graded tests link each one's reference or the student's code
+# ("links"), and the same for the executable ("program_links": DRIVER_DEPENDS
+# too). `./course grade` prints it per lab (tools/cl/labs.py, link_line).
 
 set_property(GLOBAL PROPERTY CL_LAB_MANIFEST "")
 set(CL_SANITIZE_FLAGS -fsanitize=address,undefined -g -O1 -fno-omit-frame-pointer)
@@ -151,6 +153,14 @@ function(add_lab name)
     endif()
   endforeach()
   _cl_link_chains(${name} "${driver_closure}" driver_reference_chain driver_isolated_chain student_earlier)
+  set(program_links_json "")
+  foreach(dep IN LISTS driver_closure)
+    if(dep IN_LIST student_earlier)
+      list(APPEND program_links_json "\"${dep}\": \"student\"")
+    else()
+      list(APPEND program_links_json "\"${dep}\": \"reference\"")
+    endif()
+  endforeach()
   # A lab with a reference can only have earlier labs with references (a
   # release ships the past ones, the full tree all of them).
   foreach(dep IN LISTS driver_closure)
@@ -284,8 +294,9 @@ function(add_lab name)
   list(JOIN student_json ", " student_json)
   list(JOIN deps_json ", " deps_json)
   list(JOIN links_json ", " links_json)
+  list(JOIN program_links_json ", " program_links_json)
   set_property(GLOBAL APPEND PROPERTY CL_LAB_MANIFEST
-    "    \"${name}\": {\"student\": [${student_json}], \"reference\": ${reference_json}, \"info\": ${info_json},\n      \"deps\": [${deps_json}], \"links\": {${links_json}}}")
+    "    \"${name}\": {\"student\": [${student_json}], \"reference\": ${reference_json}, \"info\": ${info_json},\n      \"deps\": [${deps_json}], \"links\": {${links_json}}, \"program_links\": {${program_links_json}}}")
 endfunction()
 
 # Writes the two-line source that names executable `program` (cl_program_name,

@@ -6,7 +6,7 @@ import sys
 from . import grade
 from .base import BIN, BUILD, ROOT, CourseError, show, under_root
 from .build import WARNING_LINES, BuildFailure, build_targets, configure, sanitizer_rerun, student_warnings
-from .labs import build_features, lab_dirs, lab_targets, manifest, resolve_lab
+from .labs import build_features, lab_dirs, lab_targets, link_line, manifest, resolve_lab
 
 
 class Grader:
@@ -123,7 +123,7 @@ def skip_tags():
                         "(macOS: brew install libomp, then remove build/ and grade again)"}
 
 
-def print_grades(results, notes, verbose=False):
+def print_grades(results, notes, verbose=False, solutions=False):
     """Per-lab table; failed cases with the reason and their context; build
     errors, warnings, notes on earlier labs; `Score: X/Y`."""
     fmt = grade.fmt_points
@@ -168,6 +168,8 @@ def print_grades(results, notes, verbose=False):
                 print(f"    {grade.clip(line, grade.TERMINAL_CAP)}")
         for note in notes.get(r.lab, []):
             print(f"  {note}")
+        if verbose and link_line(r.lab, solutions):
+            print(f"  {link_line(r.lab, solutions)}")
         if r.info:
             print(f"  {tag} information, not graded:")
             for line in r.info:
@@ -191,7 +193,7 @@ def cmd_grade(argv):
     parser.add_argument("--solutions", action="store_true", help="grade the reference code")
     parser.add_argument("-t", "--test", metavar="PATTERN",
                         help="only the cases whose name contains PATTERN (or matches it, with * wildcards)")
-    parser.add_argument("-v", "--verbose", action="store_true", help="also list the passing cases")
+    parser.add_argument("-v", "--verbose", action="store_true", help="also list the passing cases, and what each lab's tests and executable link")
     parser.add_argument("--output", default=str(BUILD / "grade" / "results.json"),
                         help="Gradescope JSON (default build/grade/results.json)")
     args = parser.parse_args(argv)
@@ -208,7 +210,7 @@ def cmd_grade(argv):
         print(f"(only the cases matching '{args.test}': "
               f"{sum(len(r.cases) for r in results)} of them)")
     notes = {r.lab: grader.dependency_notes(r.lab) for r in results}
-    print_grades(results, notes, verbose=args.verbose)
+    print_grades(results, notes, verbose=args.verbose, solutions=args.solutions)
     output = under_root(args.output)
     write_results(output, results)
     print(f"results: {show(output)}")

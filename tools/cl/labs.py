@@ -32,6 +32,32 @@ def build_features():
         return {}
 
 
+def link_line(lab, solutions=False):
+    """What LAB's graded tests and its executable link, from build/labs.json:
+    the one place the course states it (the handouts do not)."""
+    entry = manifest().get(lab, {})
+    if "program_links" not in entry:
+        return None
+
+    def labs(links, kinds):
+        chosen = [grade.lab_id(dep)[3:] for dep in sorted(links) if links[dep] in kinds]
+        return f"lab{'s' if len(chosen) > 1 else ''} {', '.join(chosen)}" if chosen else ""
+
+    def earlier(links):
+        if solutions:
+            return f"the reference of {labs(links, ('reference', 'student'))}" if links else ""
+        parts = [f"the reference of {labs(links, ('reference',))}" if labs(links, ("reference",)) else "",
+                 f"your code of {labs(links, ('student',))}" if labs(links, ("student",)) else ""]
+        return " and ".join(part for part in parts if part)
+
+    own = "the reference" if solutions else "your code"
+    tests = earlier(entry["links"]) or "no earlier lab"
+    program = earlier(entry["program_links"]) or "no earlier lab"
+    name = grade.lab_id(lab) + ("_solution" if solutions else "")
+    return (f"{grade.lab_id(lab)}'s tests link {own} of it, common/ and {tests}; "
+            f"./course run {name} links {own} of it, common/ and {program}")
+
+
 def manifest_stale():
     """True when a lab or a reference appeared or went since the last configure."""
     labs = manifest()
