@@ -402,6 +402,43 @@ std::string unknown_option_line(const CLI::App& app, int argc, char** argv) {
   }
   return "unexpected arguments (options: " + options + ")";
 }
+// An option given an empty value ("--stiffness ''"), or a list option
+// (delimiter) with an empty item ("--compare-pbd 1,,2", "1,", ",2"): the line
+// that refuses it, or "" when there is none. CLI11 would drop the empty item
+// (or take the empty value as absent) and run something the user did not ask for.
+std::string empty_value_line(const CLI::App& app, int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word.rfind("--", 0) != 0) continue;
+    std::string value;
+    const std::size_t equals = word.find('=');
+    if (equals != std::string::npos) {
+      value = word.substr(equals + 1);
+      word.resize(equals);
+    } else if (i + 1 < argc && std::string(argv[i + 1]).rfind("--", 0) != 0) {
+      value = argv[i + 1];
+    } else {
+      continue;  // no value here: CLI11 says what is missing
+    }
+    const CLI::Option* option = app.get_option_no_throw(word);
+    if (option == nullptr || option->get_type_size() == 0) continue;  // unknown (CLI11's line), or a flag
+    if (value.empty()) return word + ": empty (give a value; see --help)";
+    const char separator = option->get_delimiter();
+    if (separator == '\0') continue;
+    std::size_t item = 0;
+    std::size_t start = 0;
+    for (;; ++item) {
+      const std::size_t end = value.find(separator, start);
+      if ((end == std::string::npos ? value.size() : end) == start) {
+        return word + "[" + std::to_string(item) + "]: empty (in '" + value + "'; a list is VALUE" + separator +
+               "VALUE...)";
+      }
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+  }
+  return "";
+}
 }  // namespace
 
 int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& body,
@@ -416,6 +453,10 @@ int run_main(CLI::App& app, int argc, char** argv, const std::function<int()>& b
   if (app.get_option_no_throw("--check") == nullptr) {
     app.add_flag("--check", check,
                  "check the flags and the scene as a run would, print what would run, and stop (nothing written)");
+  }
+  if (const std::string empty = empty_value_line(app, argc, argv); !empty.empty()) {
+    std::cerr << program << ": " << empty << "\n";
+    return 2;
   }
   try {
     app.parse(argc, argv);
