@@ -110,7 +110,11 @@ KktSystem kkt_system(const LinearizedStep& step);
 // with a problem line (never NaN) when the factorization fails, the solution
 // z is not finite, or it misses the system, ‖Az − b‖∞ > 1e-8 (‖A‖∞‖z‖∞ +
 // ‖b‖∞) (a pivot that is zero only up to round-off); the LDLᵀ's answer that
-// misses is not final: the LU decides. A redundant but
+// misses is not final: the LU decides. Two of these checks are defensive, and
+// no graded case tells them apart: the test that every entry of the
+// lower-right block is < 0, and the residual check of the LDLᵀ's answer. Left
+// out, a hard constraint's 1/c_e = inf makes that answer not finite, and the
+// LU answers instead; they keep the LDLᵀ from deciding where it cannot. A redundant but
 // consistent set of hard constraints can still pass: v_new is then right (it
 // is unique) and λ one of infinitely many splits (README.md). Throws
 // std::invalid_argument when the matrix is not square, the rhs has the wrong

@@ -4,6 +4,8 @@
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <string>
+#include <tuple>
 #include <utility>
 
 #include <unistd.h>
@@ -121,6 +123,50 @@ TEST_CASE("a flag the chosen method does not use is refused in one line", "[comm
   CHECK(run_line({"--iterations", "abc"}).second == "probe: --iterations: 'abc' is not an integer (see --help)\n");
   CHECK(run_line({"--seed", "1x"}).second == "probe: --seed: '1x' is not an integer (see --help)\n");
   CHECK(run_line({"--seed", "12"}).first == 0);
+}
+
+TEST_CASE("an empty value and an empty list item are refused in one line naming the item", "[common][cli]") {
+  // CLI11 drops an empty item of a delimited list and takes "" for a string as
+  // given: "--ks 1,,2" would run K = 1, 2, and "--name ''" as if absent.
+  auto run = [](std::vector<std::string> arguments) {
+    cl::CommandLine line{"test", "probe"};
+    std::vector<int> ks;
+    std::string name;
+    bool flag = false;
+    line.add_option("--ks", ks, "a list").delimiter(',');
+    line.add_option("--name", name, "a word");
+    line.add_flag("--flag", flag, "a flag");
+    arguments.insert(arguments.begin(), "probe");
+    std::vector<char*> argv;
+    for (std::string& argument : arguments) argv.push_back(argument.data());
+    std::ostringstream captured;
+    std::streambuf* const saved = std::cerr.rdbuf(captured.rdbuf());
+    bool ran = false;
+    const int code = cl::run_main(line, static_cast<int>(argv.size()), argv.data(), [&] {
+      ran = true;
+      return 0;
+    });
+    std::cerr.rdbuf(saved);
+    return std::make_tuple(code, captured.str(), ran, ks);
+  };
+  const auto [ok_code, ok_text, ok_ran, ok_ks] = run({"--ks", "1,2", "--name", "a", "--flag"});
+  CHECK(ok_code == 0);
+  CHECK(ok_ran);
+  CHECK(ok_ks == std::vector<int>{1, 2});
+  const std::vector<std::pair<std::vector<std::string>, std::string>> refused{
+      {{"--ks", "1,,2"}, "probe: --ks[1]: empty (in '1,,2'; a list is VALUE,VALUE...)\n"},
+      {{"--ks", ",2"}, "probe: --ks[0]: empty (in ',2'; a list is VALUE,VALUE...)\n"},
+      {{"--ks=3,"}, "probe: --ks[1]: empty (in '3,'; a list is VALUE,VALUE...)\n"},
+      {{"--ks", ""}, "probe: --ks: empty (give a value; see --help)\n"},
+      {{"--name", ""}, "probe: --name: empty (give a value; see --help)\n"},
+      {{"--name="}, "probe: --name: empty (give a value; see --help)\n"}};
+  for (const auto& [arguments, line] : refused) {
+    CAPTURE(arguments);
+    const auto [code, text, ran, ks] = run(arguments);
+    CHECK(code == 2);
+    CHECK(!ran);
+    CHECK(text == line);
+  }
 }
 
 TEST_CASE("a range given to a common integer flag replaces the common one", "[common][cli]") {
