@@ -127,7 +127,9 @@ StepSolution solve_kkt(const KktSystem& system, Eigen::Index velocity_unknowns);
 // factoring the m × m matrix with cl::SpdFactorization (it is symmetric
 // positive definite when C > 0 or J has full row rank). When the factorization
 // refuses (redundant hard constraints: the matrix is singular) returns
-// ok = false with a problem line that contains "singular". Throws
+// ok = false with a problem line that contains "singular". With no springs
+// (m = 0) returns v_new = v + Δtg and an empty λ (graded; returning early is
+// defensive: cl::SpdFactorization of the 0 × 0 matrix gives the same). Throws
 // std::invalid_argument like kkt_system.
 StepSolution solve_schur(const LinearizedStep& step);
 
