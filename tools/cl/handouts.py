@@ -164,7 +164,7 @@ class PageChecker:
             return f"{words[0]} is not a command in the student's tree: write ./course run {words[0][:5]} ..."
         if words[0].startswith("build/bin/"):
             return self.check_binary(command, words[0][len("build/bin/"):], words[1:])
-        if len(words) < 3:
+        if len(words) < 3 and words[1:] != ["demo"]:
             return None  # `./course live` named in a sentence, or ./course alone: its usage
         sub, rest = words[1], words[2:]
         if sub in INSTRUCTOR_COMMANDS:
