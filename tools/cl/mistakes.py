@@ -283,6 +283,17 @@ def unmarked_entries(lab):
     return problems
 
 
+def symptom_words(entry):
+    """What the handout's entry may quote of a symptom it describes, one of
+    which it must: the text a `contains` symptom shows and, where the symptom
+    runs one graded case, the case's name; [] when there is nothing to quote."""
+    symptom = entry.get("symptom") or {}
+    if "contains" not in symptom.get("expect", {}):
+        return []
+    case = re.fullmatch(r'build/bin/\w+_tests "(.+)"', symptom["command"])
+    return [str(symptom["expect"]["contains"])] + ([case.group(1)] if case else [])
+
+
 def troubleshooting_gaps(lab, entries):
     """Markers in the handout without an entry, entries marked as
     Troubleshooting whose marker is not in the handout, and handout entries
@@ -293,7 +304,13 @@ def troubleshooting_gaps(lab, entries):
     gaps = unmarked_entries(lab)
     gaps += [f"  FAIL the handout marks '{m}', which solutions/{lab}/mistakes.json does not have"
              for m in sorted(marked - ids)]
+    said = {marker: " ".join(text.split()) for _, text in handout_entries(page) for marker in MARKER.findall(text)}
     for entry in entries:
+        shown = symptom_words(entry)
+        if (entry["id"] in said and shown and lab not in NOT_YET_MARKED
+                and not any(" ".join(words.split()) in said[entry["id"]] for words in shown)):
+            gaps.append(f"  FAIL {entry['id']}: its handout entry does not say, word for word, what the student "
+                        f"sees: \"{shown[-1]}\"")
         if entry.get("troubleshooting") and entry["id"] not in marked:
             gaps.append(f"  FAIL {entry['id']}: a Troubleshooting entry, not marked <!-- mistake: {entry['id']} -->")
         if entry.get("troubleshooting") and not entry.get("symptom"):
