@@ -51,7 +51,8 @@ usage: ./course COMMAND [ARGS]
   bench [--quick] [--micro ARGS]     the speed/accuracy trade of every method -> out/bench (bench/README.md)
   extremes [--quick]                 the extremes matrix: finite, reported or silent NaN -> out/bench
   handouts [labNN ...]               every command each handout shows, checked in its week's tree
-                                     (the lab's executable with --check: nothing is written)
+                                     (the lab's executable with --check: nothing is written;
+                                     instructor)
   claims [labNN ...] [--quick] [--solutions]
                                      every number a handout quotes, reproduced by its command
                                      (labs/*/claims.json); --quick: those that take seconds
