@@ -314,6 +314,31 @@ def matching_cases(lab, pattern):
     return [name for name in _CASES[lab] if selected(name)]
 
 
+def points_problems(lab, page):
+    """The handout's point totals ("## Your task (N points[, and H hidden])",
+    "Score: X/N") against the grader's: the [pts=N] tags of the lab's graded
+    cases, listed from its test program as ./course grade lists them."""
+    program, tag = BIN / f"{lab}_tests", grade.lab_tag(lab)
+    if not program.is_file():
+        return [f"{program.name} is not built"]
+    errors = []
+    totals = []
+    for spec in (f"{tag}~[hidden]", f"{tag}[hidden]"):
+        names = grade.list_names(program, spec)
+        totals.append(sum(grade.case_points(program, tag, names, errors).values()))
+    visible, hidden = (grade.fmt_points(total) for total in totals)
+    problems = list(errors)
+    for match in re.finditer(r"## Your task \((\d+) points?(?:, and (\d+) hidden)?\)", page):
+        # A week's tree has no hidden case (the autograder's): a page that
+        # does not name them is not wrong about them.
+        if match.group(1) != visible or match.group(2) not in (None, hidden):
+            problems.append(f"'{match.group(0)}': the graded cases give {visible} points, and {hidden} hidden")
+    for match in re.finditer(r"Score: X/(\d+)", page):
+        if match.group(1) != visible:
+            problems.append(f"'Score: X/{match.group(1)}': the graded cases give {visible} points")
+    return problems
+
+
 def check_page(path, week):
     result = PageResult(str(path.relative_to(ROOT)), week)
     checker = PageChecker(week)
@@ -349,6 +374,10 @@ def needed_targets(labs):
 def check_handouts(labs):
     """One PageResult per lab's handout (and the README's, with every lab)."""
     results = [check_page(ROOT / "labs" / lab / "README.md", lab_number(lab)) for lab in labs]
+    for lab, result in zip(labs, results):  # and its point totals, as one more check
+        result.checked += 1
+        result.problems += [f"points: {problem}" for problem in
+                            points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text())]
     if set(labs) == set(lab_dirs()):
         results.append(check_page(ROOT / "README.md", 0))
     return results
