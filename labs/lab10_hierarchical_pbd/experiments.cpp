@@ -97,7 +97,7 @@ int run_converge(const char* lab_name, const std::string& scene_dir, const Commo
       const char* limit = max_sweeps < lab.max_sweeps ? "--max-projections" : "--max-sweeps";
       const ConvergenceResult result = converge_one_step(
           scene.particles, hierarchy, scene.dt, scene.gravity, iterations, lab.targets, max_sweeps);
-      // About a hundred samples per decade of sweeps keep the CSV small.
+      // Every sweep below 200, then every (sweeps / 100)-th: the rows thin out as the sweeps grow.
       for (const ConvergenceSample& sample : result.samples) {
         const int step = std::max(1, sample.sweeps / 100);
         if (sample.sweeps % step != 0 && &sample != &result.samples.back()) continue;
