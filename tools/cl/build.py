@@ -42,7 +42,7 @@ def generator_args(build_dir):
 
 def uses_ninja(build_dir):
     cache = build_dir / "CMakeCache.txt"
-    return cache.is_file() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" in cache.read_text()
+    return cache.is_file() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" in cache.read_text(encoding="utf-8")
 
 
 def configure(log=sys.stdout, force=False):
@@ -71,7 +71,7 @@ def build(log=sys.stdout):
 def quiet(command, what):
     try:
         done = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, text=True, check=False)
+                              stderr=subprocess.STDOUT, encoding="utf-8", errors="replace", check=False)
     except FileNotFoundError:
         raise CourseError(f"{command[0]} not found; ./course installs it") from None
     if done.returncode != 0:
@@ -96,7 +96,8 @@ def build_targets(targets, build_dir=None, log=sys.stdout, label=None, keep_goin
     start = time.monotonic()
     try:
         done = subprocess.run(build_command(targets, build_dir, keep_going),
-                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              encoding="utf-8", errors="replace",
                               check=False)
     except FileNotFoundError:
         raise CourseError("cmake not found; ./course installs it") from None
@@ -145,9 +146,9 @@ def student_warnings(lab, output):
             path = str(ROOT / student)
             lines = [line.replace(str(ROOT) + "/", "") for line in output.splitlines()
                      if line.startswith(path + ":") and ": warning:" in line]
-            remembered.write_text("".join(line + "\n" for line in lines))
+            remembered.write_text("".join(line + "\n" for line in lines), encoding="utf-8")
         if remembered.is_file():
-            found += remembered.read_text().splitlines()
+            found += remembered.read_text(encoding="utf-8").splitlines()
     return found
 
 
@@ -175,7 +176,7 @@ def sanitizer_rerun(lab, case, log=sys.stdout):
     with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
         try:
             done = subprocess.run([str(binary), case.name], cwd=work, env=env, capture_output=True,
-                                  text=True, timeout=grade.CASE_TIMEOUT, check=False)
+                                  encoding="utf-8", errors="replace", timeout=grade.CASE_TIMEOUT, check=False)
         except subprocess.TimeoutExpired:
             return ["the sanitizer run timed out"]
     lines = grade.sanitizer_report(done.stdout + done.stderr, ROOT)

@@ -179,7 +179,7 @@ def check_ctest(checks):
         return
     with checks.timed("unit tests (ctest -L unit)"):
         done = subprocess.run(["ctest", "--test-dir", str(BUILD), "-L", "unit", "--output-on-failure"],
-                              cwd=ROOT, capture_output=True, text=True, check=False)
+                              cwd=ROOT, capture_output=True, encoding="utf-8", errors="replace", check=False)
     ok = done.returncode == 0
     lines = [line for line in done.stdout.splitlines() if "tests passed" in line]
     details = [] if ok else (done.stdout + done.stderr).splitlines()
@@ -264,11 +264,12 @@ def refusal_problem(program, args, expected):
         argv = [arg.replace("{tmp}", str(scratch)) for arg in args]
         for i in range(1, len(argv)):
             if argv[i - 1] == "--scene" and argv[i].startswith("{"):
-                (scratch / "bad.json").write_text(argv[i])
+                (scratch / "bad.json").write_text(argv[i], encoding="utf-8")
                 argv[i] = str(scratch / "bad.json")
         before = sorted(scratch.rglob("*"))
         try:
-            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True, text=True,
+            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True,
+                                  encoding="utf-8", errors="replace",
                                   timeout=60, check=False)
         except subprocess.TimeoutExpired:
             return "ran past 60 s instead of refusing"
@@ -371,7 +372,7 @@ def check_house_limits(checks):
     """Every file of HOUSE_LIMITS within its number of lines."""
     for pattern, limit in HOUSE_LIMITS:
         over = [f"{show(path)}: {count} lines" for path in sorted(ROOT.glob(pattern))
-                if (count := len(path.read_text().splitlines())) > limit]
+                if (count := len(path.read_text(encoding="utf-8").splitlines())) > limit]
         checks.record(not over, f"{pattern}: at most {limit} lines each", over)
 
 

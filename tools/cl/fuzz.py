@@ -52,7 +52,7 @@ def fuzz_one(program, seconds):
     done = subprocess.run([str(program), f"-max_total_time={seconds}", "-rss_limit_mb=2048",
                            "-max_len=4096" if program.name == "fuzz_scene" else "-max_len=5000",
                            f"-dict={dictionary}", f"-artifact_prefix={artifacts}/", str(corpus)],
-                          cwd=fuzz_build, capture_output=True, text=True, check=False)
+                          cwd=fuzz_build, capture_output=True, encoding="utf-8", errors="replace", check=False)
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     kept = []
     for artifact in sorted(artifacts.iterdir()):

@@ -361,7 +361,7 @@ def write_gradescope(path, labs):
                "max_score": sum(lab.max_score for lab in labs),
                "tests": tests}
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(results, indent=2) + "\n")
+    path.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
 
 
 # ---------------------------------------------------------------- sanitizer reports

@@ -63,7 +63,7 @@ class PageResult:
 def page_commands(path):
     """The commands a page shows: indented or fenced code lines and inline code
     spans that start with ./course or build/bin/ (comments and `\\` joins undone)."""
-    lines = path.read_text().splitlines()
+    lines = path.read_text(encoding="utf-8").splitlines()
     found = []
     fenced = False
     pending = None
@@ -125,7 +125,8 @@ def check_program(program, args):
     if not path.is_file():
         return f"{program} is not built"
     try:
-        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True, text=True,
+        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True,
+                              encoding="utf-8", errors="replace",
                               timeout=CHECK_SECONDS, check=False)
     except subprocess.TimeoutExpired:
         return f"--check ran past {CHECK_SECONDS} s (a path that does not stop at its start)"

@@ -53,7 +53,7 @@ def has_live_mode(lab):
     """Whether the lab's program takes --live: its driver adds common/live.h's
     flag (the time-stepping labs do; the sweep labs 01-03 do not)."""
     main = ROOT / "labs" / lab / "main.cpp"
-    return main.is_file() and "add_live_option(" in main.read_text()
+    return main.is_file() and "add_live_option(" in main.read_text(encoding="utf-8")
 
 
 def read_url(process, seconds):
@@ -82,8 +82,9 @@ def bench(program, args):
     """Latency (s, median of 50 drags) and frames per second of `program --live ARGS`."""
     import websocket  # Debian's python3-websocket
     import tempfile
-    errors = tempfile.TemporaryFile(mode="w+")
-    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, stderr=errors, text=True)
+    errors = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
+    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, stderr=errors,
+                               encoding="utf-8", errors="replace")
     try:
         try:
             port, token = read_url(process, 30)

@@ -54,7 +54,7 @@ class PlotWorkers:
         self.idle = queue.Queue()
         self.processes = [subprocess.Popen([sys.executable, str(Path(__file__).with_name("plot_worker.py"))],
                                            cwd=ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                           text=True) for _ in range(PLOT_WORKERS)]
+                                           encoding="utf-8", errors="replace") for _ in range(PLOT_WORKERS)]
         for process in self.processes:
             self.idle.put(process)
 

@@ -36,7 +36,7 @@ def load_run(folder):
     if not path.is_file():
         raise refuse(f"{show(folder)}: no trajectory.json (run the lab with --frames N --out {show(folder)})")
     try:
-        header = json.loads(path.read_text())
+        header = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as error:
         raise refuse(f"{show(path)}: not a trajectory ({error})") from None
     problem = header_problem(header)
@@ -151,7 +151,7 @@ window.addEventListener('error', function (e) {{ document.body.setAttribute('dat
 <label><input id="loop" type="checkbox" checked> loop</label>
 </div>
 <script>
-{PLAYER.read_text()}
+{PLAYER.read_text(encoding="utf-8")}
 </script>
 </body></html>
 """
@@ -161,7 +161,7 @@ def write_atomic(path, text):
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=".view-", suffix=".html")
     try:
-        with os.fdopen(handle, "w") as out:
+        with os.fdopen(handle, "w", encoding="utf-8") as out:
             out.write(text)
         umask = os.umask(0)
         os.umask(umask)

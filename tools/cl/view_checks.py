@@ -30,7 +30,7 @@ def open_in_chromium(chromium, page, frame, screenshot, size=(800, 600)):
     try:
         done = subprocess.run([chromium, *CHROMIUM_FLAGS, f"--window-size={size[0]},{size[1]}",
                                f"--screenshot={screenshot}", "--dump-dom", url],
-                              capture_output=True, text=True, timeout=60, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", timeout=60, check=False)
     except subprocess.TimeoutExpired:
         return {}, [f"{url}: Chromium ran past 60 s"]
     match = re.search(r"<body([^>]*)>", done.stdout)
@@ -120,7 +120,7 @@ def view_refusal_problems(scratch):
             shutil.copy(good / "trajectory.bin", folder)
         before = sorted(folder.iterdir())
         done = subprocess.run([sys.executable, str(ROOT / "tools" / "course.py"), "view", str(folder)],
-                              capture_output=True, text=True, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", check=False)
         lines = done.stderr.splitlines()
         if done.returncode != 2 or len(lines) != 1 or expected not in lines[0]:
             problems.append(f"view {name}: exit {done.returncode}, stderr {lines[:3]} (expected 2, one line "
@@ -134,15 +134,15 @@ def comparison_problems(scratch):
     """./course view A B without --output: the page goes to view-A-vs-B.html
     beside A, the path is printed, and A's own view.html is left alone."""
     own = scratch / "a" / "view.html"
-    own.write_text("a's own view")
+    own.write_text("a's own view", encoding="utf-8")
     done = subprocess.run([sys.executable, str(ROOT / "tools" / "course.py"), "view", str(scratch / "a"),
-                           str(scratch / "b")], capture_output=True, text=True, check=False)
+                           str(scratch / "b")], capture_output=True, encoding="utf-8", errors="replace", check=False)
     expected = scratch / "view-a-vs-b.html"
     problems = []
     if done.returncode != 0 or not expected.is_file() or expected.name not in done.stdout:
         problems.append(f"view a b: exit {done.returncode}, {expected.name} "
                         f"{'written' if expected.is_file() else 'not written'}, stdout {done.stdout.strip()[:200]!r}")
-    if own.read_text() != "a's own view":
+    if own.read_text(encoding="utf-8") != "a's own view":
         problems.append("view a b overwrote a/view.html")
     own.unlink()
     expected.unlink(missing_ok=True)
@@ -170,7 +170,7 @@ def check_browser(checks):
         runner = BIN / "lab14_contact_solution" if name == "drape" else program
         done = subprocess.run([str(runner), *args, "--out", str(scratch / name),
                                "--summary", str(scratch / f"{name}.json")],
-                              capture_output=True, text=True, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", check=False)
         if done.returncode != 0:
             checks.record(False, f"the view's runs: {runner.name} {shlex.join(args)} exited {done.returncode}",
                           done.stderr.splitlines()[-3:])
@@ -189,7 +189,7 @@ def check_browser(checks):
 
     run_a = load_run(scratch / "a")
     last = run_a[0]["frame_count"] - 1
-    final = json.loads((scratch / "a.json").read_text())["positions"]
+    final = json.loads((scratch / "a.json").read_text(encoding="utf-8"))["positions"]
     single = write_view([scratch / "a"])
     problems, shots = [], []
     for frame in (0, last):
