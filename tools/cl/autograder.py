@@ -2,7 +2,7 @@
 the CI check that builds one and grades four submissions with it.
 
 The bundle is a zip with, at its top (Gradescope unpacks it into /autograder/source):
-  setup.sh          run once as root: installs the Debian packages of ./course and
+  setup.sh          run once as root: installs what ./course grade needs (apt) and
                     builds the lab's graded tests against the stubs (tools/gradescope/)
   run_autograder    run per submission: the student's files in, rebuild, grade,
                     /autograder/results/results.json (always valid JSON)
@@ -58,7 +58,8 @@ def points_in_sources(lab):
     read from tests/LAB/*.cpp: known before anything is built."""
     tag, visible, hidden, count = grade.lab_tag(lab).lower(), 0.0, 0.0, 0
     for source in sorted((ROOT / "tests" / lab).glob("*.cpp")):
-        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', source.read_text()):
+        text = source.read_text(encoding="utf-8")
+        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', text):
             if tag not in tags.lower():
                 continue
             points = sum(float(p) for p in grade.PTS_TAG.findall(tags) if re.fullmatch(r"[0-9.]+", p))

@@ -26,7 +26,7 @@ def build_fuzzer(log=sys.stdout):
     (fuzz_live beside it)."""
     fuzz_build = BUILD / "fuzz"
     if shutil.which("clang++") is None:
-        raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
+        raise CourseError("clang++ not found (Debian and Ubuntu: apt-get install clang libclang-rt-dev)", code=2)
     if not (fuzz_build / "CMakeCache.txt").is_file():
         quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), *generator_args(fuzz_build),
                "-DCMAKE_CXX_COMPILER=clang++",

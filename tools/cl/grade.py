@@ -109,7 +109,8 @@ def source_points(test_dir, tag):
     lab can score, known even when its tests do not compile."""
     total = 0.0
     for source in sorted(Path(test_dir).glob("*.cpp")):
-        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', source.read_text()):
+        text = source.read_text(encoding="utf-8")
+        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', text):
             if tag.lower() in tags.lower() and HIDDEN_TAG not in tags.lower():
                 for spelling in PTS_TAG.findall(tags):
                     try:

@@ -28,6 +28,7 @@ from .live import read_url
 from .live_handouts import check_handouts
 from .live_hostile import IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile
 from .live_stress import FLOOD, check_stress
+from .requirements import browser as find_browser
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
                   "--enable-unsafe-swiftshader", "--window-size=800,600", "--remote-debugging-port=0",
@@ -247,7 +248,7 @@ def drive(page, process, port, token):
 def check_live(checks):
     """lab 04's reference live on a 16² curtain, driven in headless Chromium."""
     program = BIN / "lab04_pbd_solution"
-    chromium = shutil.which("chromium")
+    chromium = find_browser()
     try:
         import websocket  # noqa: F401
     except ImportError:

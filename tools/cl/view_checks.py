@@ -14,6 +14,7 @@ import sys
 
 from .base import BIN, BUILD, ROOT
 from .labs import manifest
+from .requirements import browser as find_browser
 from .view import decode_positions, load_run, write_view
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
@@ -116,7 +117,8 @@ def view_refusal_problems(scratch):
             shutil.copy(good / "trajectory.json", folder)
             (folder / "trajectory.bin").write_bytes((good / "trajectory.bin").read_bytes()[:-5])
         if name == "corrupt":
-            (folder / "trajectory.json").write_text((good / "trajectory.json").read_text()[:200])
+            cut = (good / "trajectory.json").read_text(encoding="utf-8")[:200]
+            (folder / "trajectory.json").write_text(cut, encoding="utf-8")
             shutil.copy(good / "trajectory.bin", folder)
         before = sorted(folder.iterdir())
         done = subprocess.run([sys.executable, str(ROOT / "tools" / "course.py"), "view", str(folder)],
@@ -181,10 +183,10 @@ def check_browser(checks):
     problems = comparison_problems(scratch)
     checks.record(not problems, "./course view a b writes view-a-vs-b.html beside a and says so; a/view.html "
                   "is left alone", problems)
-    chromium = shutil.which("chromium")
+    chromium = find_browser()
     if not chromium:
-        print("skip  the view in a browser: chromium is not installed (./course installs Debian's chromium "
-              "when run as root; or: sudo apt-get install chromium)")
+        print("skip  the view in a browser: no chromium, chromium-browser or google-chrome on PATH (./course test "
+              "installs Debian's chromium when run as root)")
         return
 
     run_a = load_run(scratch / "a")
