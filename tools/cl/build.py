@@ -13,8 +13,9 @@ import tempfile
 import time
 
 from . import grade
-from .base import BIN, BUILD, ROOT, CourseError
+from .base import BUILD, CONFIG, ROOT, CourseError, program
 from .labs import manifest, manifest_stale
+from .requirements import cmake_hints
 
 ERROR_LINES = 14  # of a failed build, shown
 WARNING_LINES = 3  # of the warnings in a student's files, shown
@@ -51,8 +52,8 @@ def configure(log=sys.stdout, force=False):
         print("configuring...", end=" ", file=log, flush=True)
         start = time.monotonic()
         try:
-            quiet(["cmake", "-S", str(ROOT), "-B", str(BUILD), *generator_args(BUILD), "-DCMAKE_BUILD_TYPE=Release"],
-                  "configure")
+            quiet(["cmake", "-S", str(ROOT), "-B", str(BUILD), *generator_args(BUILD), "-DCMAKE_BUILD_TYPE=Release",
+                   *cmake_hints()], "configure")
         finally:
             print(f"{time.monotonic() - start:.1f} s", file=log, flush=True)
 
@@ -81,7 +82,7 @@ def quiet(command, what):
 
 def build_command(targets, build_dir, keep_going=False):
     """The command that builds `targets` in build_dir on both cores (keep_going: past a failure)."""
-    command = ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets]
+    command = ["cmake", "--build", str(build_dir), "--config", CONFIG, "-j", "2", "--target", *targets]
     if keep_going:
         command += ["--", "-k", "0"] if uses_ninja(build_dir) else ["--", "-k"]
     return command
@@ -170,7 +171,7 @@ def sanitizer_rerun(lab, case, log=sys.stdout):
         build_targets([target], log=log, label=f"{target} (-fsanitize=address,undefined)")
     except BuildFailure as failure:
         return ["the sanitizer build failed:", *failure.lines[:4]]
-    binary = BIN / target
+    binary = program(target)
     # A crash is what is asked about here, so leaks are not reported.
     env = sanitizer_env(leaks=False)
     with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:

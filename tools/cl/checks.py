@@ -13,7 +13,8 @@ from pathlib import Path
 
 from . import grade
 from .autograder import check_autograder
-from .base import BIN, BUILD, ROOT, CourseError, show
+from .base import BUILD, ROOT, CourseError, show
+from .base import program as program_path
 from .build import BuildFailure, build_targets, configure
 from .claims import run_claims
 from .demo import index_links, run_demos, write_index, write_views
@@ -25,6 +26,7 @@ from .live_checks import check_live
 from .measure import check_measurements
 from .mistakes import catalogue, run_mistakes
 from .plots import run_plots
+from .portability import check_portability
 from .release import is_release
 from .sanitize import background_cpu, check_sanitize, start_sanitize
 from .student_loop import check_student_loop
@@ -194,9 +196,9 @@ def unregistered_cases():
     catch_discover_tests splits a name at ';' and passes it to Catch as a test
     spec: the halves of such a case match no case, and Catch 2 passes a run
     that matched none, so the case would never run in ctest."""
-    listed = "\n".join(grade.list_names(BUILD / "bin" / "common_tests"))
+    listed = "\n".join(grade.list_names(program_path("common_tests")))
     known = subprocess.run(["ctest", "--test-dir", str(BUILD), "-N", "-L", "unit"], cwd=ROOT,
-                           capture_output=True, text=True, check=False).stdout
+                           capture_output=True, encoding="utf-8", errors="replace", check=False).stdout
     names = {match.group(1) for match in re.finditer(r"Test\s+#\d+: (.*)$", known, re.MULTILINE)}
     cases = [name.strip() for name in listed.splitlines() if name.strip()]
     return [name for name in cases if name not in names]
@@ -298,7 +300,7 @@ def check_rejects(checks, labs):
         if not cases:
             continue
         name = lab + ("_solution" if entries[lab]["reference"] else "")
-        program = BIN / name
+        program = program_path(name)
         problems = []
         for args, expected in cases:
             problem = refusal_problem(program, args, expected)
@@ -394,6 +396,7 @@ def cmd_test(argv):
         checks.record(False, str(error), error.details)
         return checks.finish()
     check_house_limits(checks)
+    check_portability(checks)  # text I/O's encodings, the requirement messages: about a second
     # The sanitizer build compiles, then runs the suite, in the background,
     # niced, from the start: niced, it takes what the foreground leaves (the
     # main build's links and its last files, the checks that run one process

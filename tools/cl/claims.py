@@ -21,7 +21,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from .base import BIN, ROOT, CourseError
+from .base import ROOT, CourseError
+from .base import program as executable_path
 from .build import BuildFailure, build_targets, configure
 from .labs import lab_dirs, manifest, resolve_lab
 
@@ -83,7 +84,8 @@ def run_command(command, solutions, scratch, timeout, bin_dir=None):
     name, args = program_of(command, solutions)
     start = time.monotonic()
     try:
-        done = subprocess.run([str((bin_dir or BIN) / name), *args], cwd=scratch, capture_output=True, text=True,
+        done = subprocess.run([str(executable_path(name, bin_dir)), *args], cwd=scratch, capture_output=True,
+                              encoding="utf-8", errors="replace",
                               timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
         return f"(ran past {timeout} s)", -1, time.monotonic() - start

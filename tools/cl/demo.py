@@ -12,7 +12,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 from . import grade
-from .base import ROOT, CourseError, show, under_root
+from .base import ROOT, CourseError, become, show, under_root
 from .build import BuildFailure, build_targets, configure
 from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
 from .plots import plots_failed, run_plots
@@ -214,5 +214,4 @@ def cmd_run(argv):
     except BuildFailure as failure:
         raise CourseError(f"{name} does not build", details=failure.lines) from None
     program = executable(name)
-    sys.stdout.flush()
-    os.execv(program, [str(program), *argv[1:]])
+    return become(program, [str(program), *argv[1:]])

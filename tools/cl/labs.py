@@ -10,7 +10,7 @@ import shlex
 from pathlib import Path
 
 from . import grade
-from .base import BIN, BUILD, ROOT, CourseError, show
+from .base import BUILD, ROOT, CourseError, program, show
 
 MANIFEST = BUILD / "labs.json"
 
@@ -53,7 +53,7 @@ def resolve_lab(token):
 
 
 def executable(name):
-    path = BIN / name
+    path = program(name)
     if not path.is_file():
         raise CourseError(f"{show(path)} not found (is it added in CMakeLists.txt?)")
     return path

@@ -10,7 +10,6 @@ a drag message to the first frame that shows the particle held there (the
 median of 50 drags), and the frames per second at speed 16 (as fast as the
 steps go)."""
 import json
-import os
 import re
 import statistics
 import subprocess
@@ -18,7 +17,7 @@ import sys
 import time
 
 from . import grade
-from .base import ROOT, CourseError
+from .base import ROOT, CourseError, become
 from .build import BuildFailure, build_targets, configure
 from .labs import executable, lab_dirs, resolve_lab
 
@@ -152,5 +151,4 @@ def cmd_live(argv):
         print(f"{name} {' '.join(args[2:])}: {n} particles; drag to frame {1e3 * latency:.2f} ms (median of 50); "
               f"{rate:.0f} frames/s received, {steps:.0f} steps/s at speed 16")
         return 0
-    sys.stdout.flush()
-    os.execv(str(program), [str(program), *args[1:]])
+    return become(program, [str(program), *args[1:]])
