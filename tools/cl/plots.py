@@ -22,7 +22,8 @@ from .labs import lab_dirs, resolve_lab
 
 PLOT_SKIPPED = 4  # a plot script's exit code when its input is not in DIR (plots/_figures.py)
 PLOT_ERROR_LINES = 12  # of a failing plot script's stderr, shown
-PLOT_WORKERS = 2  # scripts drawn at once (each in a process forked from a runner, tools/cl/plot_worker.py)
+PLOT_WORKERS = 2  # scripts drawn at once (each in a process forked from a runner, tools/cl/plot_worker.py;
+#                   a process of its own where there is no fork)
 
 
 @dataclass
