@@ -208,7 +208,9 @@ def probe(system, need):
             path = system.header(name)
             if path is None:
                 continue
-            if need is EIGEN:  # 3.4 or later (5.x numbers itself anew but keeps 3 as its "world")
+            if need is EIGEN:  # 3.4, or 5.x (whose version is in Eigen/Version; its Macros.h keeps world 3)
+                if (path.parent / "Version").is_file():
+                    return True
                 text = (path.parent / "src/Core/util/Macros.h").read_text(encoding="utf-8", errors="replace")
                 return (version_of(text, "EIGEN_WORLD_VERSION", "EIGEN_MAJOR_VERSION") or (0, 0)) >= (3, 4)
             if name == "catch2/catch.hpp":  # Catch2 2.x: 2.13 at least
