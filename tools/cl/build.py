@@ -132,7 +132,14 @@ def first_errors(output):
             start -= 1
         shown = lines[start:start + ERROR_LINES]
     # A path relative to the build folder (ccache's base_dir in ./course test) reads from the root too.
-    return [re.sub(r"(^|[\s(])\.\./(?=\w)", r"\1", line.replace(str(ROOT) + "/", "")) for line in shown]
+    return [re.sub(r"(^|[\s(])\.\./(?=\w)", r"\1", from_root(line)) for line in shown]
+
+
+def from_root(line):
+    """A compiler's line with the tree's paths relative to it (MinGW's say C:/..., or C:\\...)."""
+    for prefix in {ROOT.as_posix() + "/", str(ROOT) + os.sep}:
+        line = line.replace(prefix, "")
+    return line
 
 
 def student_warnings(lab, output):
@@ -144,9 +151,8 @@ def student_warnings(lab, output):
     for student in manifest().get(lab, {}).get("student", []):
         remembered = cache / (student.replace("/", "__") + ".txt")
         if f"CMakeFiles/{lab}_student.dir/{student}.o" in output:
-            path = str(ROOT / student)
-            lines = [line.replace(str(ROOT) + "/", "") for line in output.splitlines()
-                     if line.startswith(path + ":") and ": warning:" in line]
+            lines = [from_root(line) for line in output.splitlines()
+                     if from_root(line).startswith(student + ":") and ": warning:" in line]
             remembered.write_text("".join(line + "\n" for line in lines), encoding="utf-8")
         if remembered.is_file():
             found += remembered.read_text(encoding="utf-8").splitlines()
