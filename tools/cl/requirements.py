@@ -339,6 +339,7 @@ def ensure(command, system=None, log_path=None, recommends=True):
         if not install(required + optional, system, log_path, recommends):
             return 1, f"course {command}: apt-get failed, see {log_path}"
         system.found.clear()
+        importlib.invalidate_caches()  # python3-matplotlib and the like, just installed for this Python
         required, _ = missing(command, system)
         if not required:
             return 0, None
