@@ -22,6 +22,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 MSYS2 = "mingw-w64-x86_64-"  # MSYS2's MINGW64 packages
+PIP = {"PIL": "pillow", "websocket": "websocket-client"}  # a module's pip name, where it differs
 BROWSERS = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 
 
@@ -304,6 +305,9 @@ def message(command, needs, system):
         how = ("on Windows use WSL2 (Ubuntu 24.04) or the dev container (README), or, for the native "
                f"MinGW-w64 build, in MSYS2's MINGW64 shell: {line}" if line else
                "on Windows use WSL2 (Ubuntu 24.04) or the dev container (README)")
+        modules = [PIP.get(name, name) for need in needs if need.kind == "module" for name in need.names]
+        if modules:  # python.org's Python (the py launcher) takes them from pip, not from MSYS2
+            how += f"; python.org's Python: py -3 -m pip install {' '.join(modules)}"
     elif system.kind == "linux":
         how = "install them with your system's package manager (Debian and Ubuntu: ./course installs them as root)"
     else:
