@@ -315,12 +315,15 @@ def message(command, needs, system):
     return f"course {command}: missing {what}; {how}"
 
 
+def shown(path):
+    return path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+
+
 def install(needs, system, log_path, recommends=True):
     """apt-get install the packages of `needs` (root on Debian); False when apt failed."""
     names = apt_names(needs, system)
     log_path.parent.mkdir(parents=True, exist_ok=True)
-    print(f"course: installing {' '.join(names)} (log: {log_path.relative_to(ROOT) if log_path.is_relative_to(ROOT) else log_path})",
-          flush=True)
+    print(f"course: installing {' '.join(names)} (log: {shown(log_path)})", flush=True)
     env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
     extra = [] if recommends else ["--no-install-recommends"]
     with open(log_path, "a", encoding="utf-8") as log:
@@ -341,7 +344,7 @@ def ensure(command, system=None, log_path=None, recommends=True):
     if system.kind == "debian" and system.root and system.apt_known is None:
         log_path = log_path or ROOT / os.environ.get("CL_BUILD_DIR", "build") / "apt.log"
         if not install(required + optional, system, log_path, recommends):
-            return 1, f"course {command}: apt-get failed, see {log_path}"
+            return 1, f"course {command}: apt-get failed, see {shown(log_path)}"
         system.found.clear()
         importlib.invalidate_caches()  # python3-matplotlib and the like, just installed for this Python
         required, _ = missing(command, system)
