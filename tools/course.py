@@ -1,10 +1,13 @@
 """Constraint Labs driver: build, demo, test, grade, run, plots, bench.
 
-Started by ../course, which installs the Debian packages and picks a Python
-with matplotlib. The commands live in the package tools/cl/, one module per
+Started by ../course (or ../course.cmd on Windows), which picks a Python.
+Before a command runs, what it needs is checked by what the system can do
+(tools/cl/requirements.py: installed with apt on Debian as root, else one line
+saying how). The commands live in the package tools/cl/, one module per
 concern (docs/DESIGN.md §1); this file only dispatches. Paths are relative to
 the course root, not the cwd.
 """
+import os
 import sys
 
 from cl.autograder import cmd_autograder
@@ -20,6 +23,7 @@ from cl.measure import cmd_bench, cmd_extremes
 from cl.mistakes import cmd_mistakes
 from cl.plots import cmd_plots
 from cl.release import cmd_release
+from cl.requirements import ensure
 from cl.sanitize import cmd_sanitize
 from cl.view import cmd_view
 
@@ -67,6 +71,9 @@ COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_r
 
 
 def main(argv):
+    if os.name == "nt":  # a redirected stdout is the locale's (cp1252) there: the course prints UTF-8 (−, ², ≥)
+        for stream in (sys.stdout, sys.stderr):
+            stream.reconfigure(encoding="utf-8", errors="replace")
     if not argv or argv[0] in ("help", "-h", "--help"):
         print(USAGE)
         return 0
@@ -74,6 +81,11 @@ def main(argv):
     if command is None:
         print(f"course: unknown command '{argv[0]}' (try ./course help)", file=sys.stderr)
         return 2
+    code, missing = ensure(argv[0])
+    if missing:
+        print(missing, file=sys.stderr)
+    if code:
+        return code
     try:
         return command(argv[1:])
     except CourseError as error:
