@@ -7,6 +7,7 @@ saying how). The commands live in the package tools/cl/, one module per
 concern (docs/DESIGN.md §1); this file only dispatches. Paths are relative to
 the course root, not the cwd.
 """
+import argparse
 import os
 import sys
 
@@ -61,13 +62,32 @@ usage: ./course COMMAND [ARGS]
                                      each planted: the grader must catch it (instructor)
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
   sanitize                           the whole test suite under AddressSanitizer and UBSan (build-asan)
+  setup [--all]                      install what the student's commands need (Debian and Ubuntu
+                                     as root), or print the one line that does; --all: the
+                                     instructor's too (what ./course test needs)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
+def cmd_setup(argv):
+    """./course setup [--all]: what the commands need, installed or told, at once
+    rather than at a command's first run (the dev container's image runs it)."""
+    parser = argparse.ArgumentParser(prog="course setup", description="install what the course needs")
+    parser.add_argument("--all", action="store_true", help="the instructor's too (what ./course test needs)")
+    args = parser.parse_args(argv)
+    code, missing = ensure("test" if args.all else "demo")
+    if missing:
+        print(missing, file=sys.stderr)
+    else:
+        print(f"course setup: what {'every command needs' if args.all else 'the student' + chr(39) + 's commands need'} "
+              "need is installed")
+    return code
+
+
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
+            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live,
+            "setup": cmd_setup}
 
 
 def main(argv):
