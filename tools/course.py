@@ -79,8 +79,8 @@ def cmd_setup(argv):
     if missing:
         print(missing, file=sys.stderr)
     else:
-        print(f"course setup: what {'every command needs' if args.all else 'the student' + chr(39) + 's commands need'} "
-              "need is installed")
+        who = "every command" if args.all else "the student's commands"
+        print(f"course setup: what {who} need is installed")
     return code
 
 
