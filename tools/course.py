@@ -79,8 +79,8 @@ def cmd_setup(argv):
     if missing:
         print(missing, file=sys.stderr)
     else:
-        who = "every command" if args.all else "the student's commands"
-        print(f"course setup: what {who} need is installed")
+        who = "every command needs" if args.all else "the student's commands need"
+        print(f"course setup: what {who} is installed")
     return code
 
 
