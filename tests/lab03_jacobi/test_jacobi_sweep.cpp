@@ -238,10 +238,16 @@ TEST_CASE("x_next is resized and bad shapes or bad omega throw std::invalid_argu
   Anchored scene(0.1);
   const cl::lab03::Incidence incidence = build_incidence(3, scene.springs);
   SECTION("x_next is resized") {
-    Matrix3Xd x_next;
-    jacobi_sweep(scene.x, x_next, scene.inv_mass, scene.springs, incidence, 1.0, Averaging::kByCount);
-    REQUIRE(x_next.cols() == 3);
-    REQUIRE(cl::test::near(x_next(0, 1), 1.0, 1e-15, "x of the free particle"));
+    // Empty, too many columns, too few: a driver may hand in any buffer.
+    for (const Eigen::Index columns : {0, 7, 1}) {
+      CAPTURE(columns);
+      Matrix3Xd x_next = Matrix3Xd::Constant(3, columns, 42.0);
+      jacobi_sweep(scene.x, x_next, scene.inv_mass, scene.springs, incidence, 1.0, Averaging::kByCount);
+      REQUIRE(cl::test::near(static_cast<double>(x_next.cols()), 3.0, 0.0, "columns of x_next"));
+      Matrix3Xd expected = scene.x;
+      expected(0, 1) = 1.0;  // the free particle, back at rest; the anchors unchanged
+      REQUIRE(cl::test::near(x_next, expected, 1e-15, "particle"));
+    }
   }
   SECTION("throws") {
     Matrix3Xd x_next;
@@ -260,5 +266,14 @@ TEST_CASE("x_next is resized and bad shapes or bad omega throw std::invalid_argu
     REQUIRE_THROWS_AS(jacobi_sweep(scene.x, x_next, VectorXd{{0.0, -1.0, 0.0}}, scene.springs, incidence, 1.0,
                                    Averaging::kByCount),
                       std::invalid_argument);
+    // A bad rest length is refused before the parallel loop too: thrown inside
+    // it, project_distance's exception would end the process instead.
+    for (const double rest_length : {-0.5, std::nan(""), HUGE_VAL}) {
+      CAPTURE(rest_length);
+      std::vector<Spring> springs = scene.springs;
+      springs[1].rest_length = rest_length;
+      REQUIRE_THROWS_AS(jacobi_sweep(scene.x, x_next, scene.inv_mass, springs, incidence, 1.0, Averaging::kByCount),
+                        std::invalid_argument);
+    }
   }
 }

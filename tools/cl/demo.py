@@ -18,7 +18,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 from . import grade
-from .base import ROOT, CourseError, show, under_root
+from .base import ROOT, CourseError, become, show, under_root
 from .build import BuildFailure, build_targets, configure
 from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
 from .plots import plots_failed, run_plots
@@ -89,7 +89,7 @@ def run_lab_demo(demo, lab, lab_out, own, echo, quick):
         if echo:
             print("  " + shown, flush=True)
         argv = [str(program), *(arg.replace("{out}", str(lab_out)) for arg in args)]
-        done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, check=False)
+        done = subprocess.run(argv, cwd=ROOT, capture_output=True, encoding="utf-8", errors="replace", check=False)
         if done.returncode == 0:
             continue
         said = done.stderr.strip().splitlines()
@@ -205,7 +205,7 @@ coloured by strain. Make your own with <code>./course view DIR [DIR2]</code>.</p
 
 def write_index(out, demo=None):
     path = out / "index.html"
-    path.write_text(index_page(out, demo))
+    path.write_text(index_page(out, demo), encoding="utf-8")
     return path
 
 
@@ -220,7 +220,7 @@ def index_links(out):
                     if not (out / value).is_file():
                         missing.append(value)
 
-    Links().feed((out / "index.html").read_text())
+    Links().feed((out / "index.html").read_text(encoding="utf-8"))
     return missing
 
 
@@ -231,7 +231,7 @@ def summaries(out, labs=None):
         if labs is not None and path.parent.name not in labs:
             continue
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
         if isinstance(data, dict) and "lab" in data and "seconds" in data:
@@ -315,5 +315,4 @@ def cmd_run(argv):
     except BuildFailure as failure:
         raise CourseError(f"{name} does not build", details=failure.lines) from None
     program = executable(name)
-    sys.stdout.flush()
-    os.execv(program, [str(program), *argv[1:]])
+    return become(program, [str(program), *argv[1:]])

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import grade
-from .base import BIN, ROOT, CourseError
+from .base import ROOT, CourseError
+from .base import program as executable_path
 from .build import BuildFailure, build_targets, configure
 from .demo import demo_folders
 from .labs import demo_lines, lab_dirs, manifest, resolve_lab
@@ -65,7 +66,7 @@ class PageResult:
 def page_commands(path):
     """The commands a page shows: indented or fenced code lines and inline code
     spans that start with ./course or build/bin/ (comments and `\\` joins undone)."""
-    lines = path.read_text().splitlines()
+    lines = path.read_text(encoding="utf-8").splitlines()
     found = []
     fenced = False
     pending = None
@@ -123,11 +124,12 @@ class Week:
 
 def check_program(program, args):
     """Run PROGRAM ARGS --check from the course root; the problem, or None."""
-    path = BIN / program
+    path = executable_path(program)
     if not path.is_file():
         return f"{program} is not built"
     try:
-        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True, text=True,
+        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True,
+                              encoding="utf-8", errors="replace",
                               timeout=CHECK_SECONDS, check=False)
     except subprocess.TimeoutExpired:
         return f"--check ran past {CHECK_SECONDS} s (a path that does not stop at its start)"
@@ -309,7 +311,7 @@ def matching_cases(lab, pattern):
     """The lab's graded cases that `./course grade LAB -t PATTERN` would run."""
     if lab not in _CASES:
         # The student's and the reference's programs hold the same cases (compiled once, linked twice).
-        _CASES[lab] = grade.list_names(BIN / f"{lab}_tests", grade.lab_tag(lab))
+        _CASES[lab] = grade.list_names(executable_path(f"{lab}_tests"), grade.lab_tag(lab))
     selected = grade.case_filter(pattern)
     return [name for name in _CASES[lab] if selected(name)]
 
@@ -318,7 +320,7 @@ def points_problems(lab, page):
     """The handout's point totals ("## Your task (N points[, and H hidden])",
     "Score: X/N") against the grader's: the [pts=N] tags of the lab's graded
     cases, listed from its test program as ./course grade lists them."""
-    program, tag = BIN / f"{lab}_tests", grade.lab_tag(lab)
+    program, tag = executable_path(f"{lab}_tests"), grade.lab_tag(lab)
     if not program.is_file():
         return [f"{program.name} is not built"]
     errors = []
@@ -377,7 +379,7 @@ def check_handouts(labs):
     for lab, result in zip(labs, results):  # and its point totals, as one more check
         result.checked += 1
         result.problems += [f"points: {problem}" for problem in
-                            points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text())]
+                            points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
     if set(labs) == set(lab_dirs()):
         results.append(check_page(ROOT / "README.md", 0))
     return results

@@ -94,7 +94,7 @@ def read_messages(sock, until, want):
 
 
 def rss(pid):
-    with open(f"/proc/{pid}/status") as status:
+    with open(f"/proc/{pid}/status", encoding="utf-8") as status:
         for line in status:
             if line.startswith("VmRSS:"):
                 return int(line.split()[1]) * 1024
@@ -313,7 +313,7 @@ def check_stress(program):
     import subprocess
     from .live import read_url
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, errors="replace")
+                               stderr=subprocess.PIPE, encoding="utf-8", errors="replace")
     problems, numbers = [], {}
     try:
         port, token = read_url(process, 20)
