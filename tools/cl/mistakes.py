@@ -33,14 +33,6 @@ CASE_TIMEOUT = 120
 MARKER = re.compile(r"<!--\s*mistake:\s*([\w-]+)\s*-->")
 ADVICE = re.compile(r"<!--\s*advice\s*-->")  # an entry of advice: no mistake, no symptom to check
 ENTRY_SECTIONS = re.compile(r"^#+ .*(troubleshooting|messages)", re.IGNORECASE)
-# Issue 66: labs 03 and 10's entries are being catalogued on their own branch;
-# the checks of the entries take each of them from its first <!-- advice -->
-# on (not_yet_marked), and this set can go once that branch is merged.
-NOT_YET_MARKED = {"lab03_jacobi", "lab10_hierarchical_pbd"}
-
-
-def not_yet_marked(lab, page):
-    return lab in NOT_YET_MARKED and not ADVICE.search(page)
 
 
 def catalogue(lab):
@@ -278,8 +270,6 @@ def unmarked_entries(lab):
     catalogued mistake (<!-- mistake: ID -->, whose symptom ./course mistakes
     checks) nor marked <!-- advice --> (no symptom to check), or are both."""
     page = (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8")
-    if not_yet_marked(lab, page):
-        return []
     problems = []
     for line, text in handout_entries(page):
         kinds = len(MARKER.findall(text)) + len(ADVICE.findall(text))
@@ -314,7 +304,7 @@ def troubleshooting_gaps(lab, entries):
     said = {marker: " ".join(text.split()) for _, text in handout_entries(page) for marker in MARKER.findall(text)}
     for entry in entries:
         shown = symptom_words(entry)
-        if (entry["id"] in said and shown and not not_yet_marked(lab, page)
+        if (entry["id"] in said and shown
                 and not any(" ".join(words.split()) in said[entry["id"]] for words in shown)):
             gaps.append(f"  FAIL {entry['id']}: its handout entry does not say, word for word, what the student "
                         f"sees: \"{shown[-1]}\"")
