@@ -38,7 +38,8 @@ usage: ./course COMMAND [ARGS]
   grade [labNN ...] [-t PATTERN] [-v] [--solutions] [--output FILE]
                                      graded tests (each lab built on its own): Score: X/Y,
                                      build/grade/results.json; -t: only matching cases,
-                                     -v: list passing cases too
+                                     -v: list passing cases too, and what each lab's tests and
+                                     executable link
   release labNN DIR                  the student tree for lab NN's week: stubs, and the
                                      reference code of the labs before NN
   autograder labNN [--out FILE.zip]  the Gradescope autograder for lab NN (its hidden tests
