@@ -36,7 +36,7 @@ from .release import is_release
 INSTRUCTOR_COMMANDS = {"bench", "extremes", "fuzz", "sanitize", "release", "autograder"}
 INSTRUCTOR_PROGRAMS = re.compile(r"^(trade|extremes|bench_\w+)$")
 INSTRUCTOR_LINES = 4
-STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view", "claims"}
+STUDENT_COMMANDS = {"setup", "demo", "test", "help", "run", "live", "grade", "plots", "view", "claims"}
 INSTRUCTOR_COMMANDS |= {"mistakes", "handouts"}
 # A usage line, not a command: a placeholder in capitals (DIR, PATTERN, ARGS) or labNN.
 TEMPLATE = re.compile(r"\b(labNN\w*|[A-Z]{2,}[A-Z0-9_]*)\b|…|\.\.\.")
