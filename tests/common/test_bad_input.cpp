@@ -2,6 +2,7 @@
 // exit code 2, one stderr line naming the file and the field, no output left.
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
