@@ -2,6 +2,7 @@
 // the live server, common/live_server.h): the labs build and run, and --live
 // is refused in one line that says what to install.
 #include "common/live.h"
+#include "common/output.h"
 
 namespace cl {
 
