@@ -14,6 +14,7 @@
 #include <random>
 #include <set>
 #include <thread>
+#include <utility>
 
 #include <boost/asio.hpp>
 #include <boost/beast/core.hpp>
@@ -35,15 +36,8 @@ using beast::error_code;
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-double since(Clock::time_point then, Clock::time_point now) { return std::chrono::duration<double>(now - then).count(); }
-
+double since(Clock::time_point then) { return std::chrono::duration<double>(Clock::now() - then).count(); }
 std::chrono::milliseconds millis(double seconds) { return std::chrono::milliseconds(static_cast<long>(seconds * 1000.0)); }
-
-std::string lower(std::string text) {
-  for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return text;
-}
 
 // A header's value as a stderr line may show it: at most 80 bytes, printable ASCII ('?' for the rest).
 std::string shown(beast::string_view text) {
@@ -52,65 +46,51 @@ std::string shown(beast::string_view text) {
   return out;
 }
 
-std::string error_message(const std::string& line) { return live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}); }
-
 struct LogState {
   std::mutex mutex;
   Clock::time_point window = Clock::now();
   int printed = 0;
   long hidden = 0;
-};
-LogState& log_state() {
-  static LogState state;
-  return state;
-}
+} log_state;
 
-void log_roll(LogState& state, Clock::time_point now, bool final = false) {  // with state.mutex held
-  if (since(state.window, now) < 1.0 && !final) return;
-  if (state.hidden > 0) {
-    std::fprintf(stderr, "live: %ld more lines like these in the last %.0f s, not shown\n", state.hidden,
-                 std::max(1.0, since(state.window, now)));
+void log_roll(bool final) {  // with log_state.mutex held
+  if (since(log_state.window) < 1.0 && !final) return;
+  if (log_state.hidden > 0) {
+    std::fprintf(stderr, "live: %ld more lines like these in the last %.0f s, not shown\n", log_state.hidden,
+                 std::max(1.0, since(log_state.window)));
   }
-  state.window = now;
-  state.printed = 0;
-  state.hidden = 0;
+  log_state.window = Clock::now();
+  log_state.printed = 0;
+  log_state.hidden = 0;
 }
 
 }  // namespace
 
 void live_log(const std::string& line) {
-  LogState& state = log_state();
-  const std::lock_guard<std::mutex> lock(state.mutex);
-  log_roll(state, Clock::now());
-  if (state.printed < kLiveLogPerSecond) {
-    ++state.printed;
-    std::fprintf(stderr, "%s\n", line.c_str());
-  } else {
-    ++state.hidden;
-  }
+  const std::lock_guard<std::mutex> lock(log_state.mutex);
+  log_roll(false);
+  if (log_state.printed++ < kLiveLogPerSecond) std::fprintf(stderr, "%s\n", line.c_str());
+  else ++log_state.hidden;
 }
 
 void live_log_flush(bool final) {
-  LogState& state = log_state();
-  const std::lock_guard<std::mutex> lock(state.mutex);
-  log_roll(state, Clock::now(), final);
+  const std::lock_guard<std::mutex> lock(log_state.mutex);
+  log_roll(final);
 }
 
 std::string live_token() {
   std::random_device device;
   std::string token;
-  static const char* digits = "0123456789abcdef";
   for (int word = 0; word < 4; ++word) {
     std::uint32_t bits = device();
-    for (int d = 0; d < 8; ++d, bits >>= 4) token += digits[bits & 15u];
+    for (int d = 0; d < 8; ++d, bits >>= 4) token += "0123456789abcdef"[bits & 15u];
   }
   return token;
 }
 
 bool live_origin_allowed(const std::optional<std::string>& origin, int port) {
-  if (!origin) return true;
   const std::string tail = ":" + std::to_string(port);
-  return *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail;
+  return !origin || *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail;
 }
 
 bool live_host_allowed(const std::string& host, int port) {
@@ -120,11 +100,9 @@ bool live_host_allowed(const std::string& host, int port) {
 
 bool live_token_matches(const std::optional<std::string>& query, const std::string& token) {
   if (!query || token.empty()) return false;
-  const std::string& text = *query;
-  std::size_t start = 0;
-  while (start <= text.size()) {
-    const std::size_t end = std::min(text.find('&', start), text.size());
-    if (text.compare(start, end - start, "token=" + token) == 0 && end - start == token.size() + 6) return true;
+  for (std::size_t start = 0; start <= query->size();) {
+    const std::size_t end = std::min(query->find('&', start), query->size());
+    if (query->compare(start, end - start, "token=" + token) == 0 && end - start == token.size() + 6) return true;
     start = end + 1;
   }
   return false;
@@ -134,55 +112,53 @@ bool live_head_folded(const std::string& head) {
   return head.find("\r\n ") != std::string::npos || head.find("\r\n\t") != std::string::npos;
 }
 
-// What the live loop and the server's thread share, under `mutex`.
-struct LiveServer::Shared {
-  struct Client {
-    std::deque<LiveInbound> inbound;  // ends with the closing once the client has gone
-    bool gone = false;
-    bool unread = false;              // its queue was full: the server stopped reading it
-    std::deque<std::string> texts;    // waiting for the socket
-    std::size_t text_bytes = 0;
-    std::string status, data;         // the newest frame (its status and positions), empty when none waits
-    bool frame = false;
+struct LiveServer::State {
+  struct Request;
+  struct Socket;
+  // What the live loop and the server's thread share, under `mutex`: each client's messages, and its
+  // frames in flight. Everything else is the server thread's alone; the loop posts to it.
+  struct Inbox {
+    std::deque<LiveInbound> inbound;    // ends with the closing once the client has gone
+    bool gone = false, unread = false;  // unread: its queue was full, the server stopped reading it
     int in_flight = 0;
   };
   std::mutex mutex;
   std::condition_variable inbound_ready;
-  std::map<int, Client> clients;
+  std::map<int, Inbox> inboxes;
   int last_taken = 0;  // take_inbound starts after this client: every client gets its turn
   std::atomic<bool> stop{false};
-};
 
-// The server's thread: the io_context and what only its handlers touch.
-struct LiveServer::Io {
-  struct Request;
-  struct Socket;
-
-  net::io_context context{1};  // first: the handlers it still holds are destroyed before the rest
+  net::io_context context{1};  // before what its handlers hold: destroyed after them
   tcp::acceptor acceptor{context};
   net::signal_set signals{context, SIGINT, SIGTERM};
-  net::steady_timer sweep{context};
-  net::steady_timer retry{context};
+  net::steady_timer sweep{context}, retry{context};
   LiveServer* server = nullptr;
-  Shared* shared = nullptr;
   std::string page;
   std::list<std::weak_ptr<Request>> pending;  // connections still sending their request, oldest first
   std::map<int, std::shared_ptr<Socket>> sockets;
-  int next_client = 1;
-  Clock::time_point window = Clock::now();  // the second in which `opened` WebSockets were accepted
-  int opened = 0;
+  int next_client = 1, opened = 0;  // opened: the WebSockets accepted in the second since `window`
+  Clock::time_point window = Clock::now();
   std::thread thread;
 
   void accept();
-  void check_sockets();
-  void pump(int client);
-  void resume(int client);
+  void check_stalls();
+  void inbound(const LiveInbound& event, bool* full = nullptr) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex);
+      Inbox& inbox = inboxes[event.client];
+      inbox.gone = inbox.gone || event.closed;
+      inbox.inbound.push_back(event);
+      if (full) *full = inbox.unread = inbox.inbound.size() >= kInboundPerClient;  // read again once the loop took some
+    }
+    inbound_ready.notify_one();
+  }
+  template <class Action> void post(Action action) { net::post(context, std::move(action)); }
 };
 
 // One HTTP connection until its request is answered or becomes a WebSocket.
-struct LiveServer::Io::Request : std::enable_shared_from_this<Request> {
-  Request(Io& owner, tcp::socket socket) : io(owner), stream(std::move(socket)) {}
-  Io& io;
+struct LiveServer::State::Request : std::enable_shared_from_this<Request> {
+  Request(State& owner, tcp::socket socket) : state(owner), stream(std::move(socket)) {}
+  State& state;
   beast::tcp_stream stream;
   std::string head;
   bool answered = false;
@@ -194,121 +170,157 @@ struct LiveServer::Io::Request : std::enable_shared_from_this<Request> {
     net::async_read_until(stream, net::dynamic_buffer(head, kRequestCap), "\r\n\r\n",
                           [self = shared_from_this()](error_code error, std::size_t size) { self->on_head(error, size); });
   }
+  void respond(http::status status, std::string body, const std::string& line = "", const char* type = "text/plain; charset=utf-8") {
+    if (!line.empty()) live_log(line);
+    answered = true;
+    answer = http::response<http::string_body>(status, 11);
+    answer.set(http::field::content_type, type);
+    answer.set(http::field::cache_control, "no-store");
+    if (status == http::status::service_unavailable) answer.set(http::field::retry_after, "1");
+    answer.keep_alive(false);
+    answer.body() = std::move(body);
+    answer.prepare_payload();
+    stream.expires_after(millis(kStalledSeconds));
+    http::async_write(stream, answer, [self = shared_from_this()](error_code error, std::size_t) {
+      if (error) return self->stream.close();
+      self->stream.socket().shutdown(tcp::socket::shutdown_send, error);
+      self->stream.expires_after(std::chrono::seconds(2));
+      self->discard();  // what the client still sends is read and dropped: closing on it would reset the answer away
+    });
+  }
+  void discard() {
+    stream.async_read_some(net::buffer(drain), [self = shared_from_this()](error_code error, std::size_t) {
+      if (error) return self->stream.close();
+      self->discard();
+    });
+  }
   void on_head(error_code error, std::size_t size);
-  void refuse(http::status status, const std::string& body, const std::string& line = "");
-  void respond(http::status status, const char* type, std::string body);
-  void discard();
 };
 
-// One WebSocket: Beast's stream, what is being written to it, when it was last heard.
-struct LiveServer::Io::Socket : std::enable_shared_from_this<Socket> {
-  Socket(Io& owner, beast::tcp_stream&& stream, int client_id) : io(owner), ws(std::move(stream)), id(client_id) {}
-  Io& io;
+// One WebSocket: Beast's stream, its outbox (texts in order, then the newest frame), when it was last heard.
+struct LiveServer::State::Socket : std::enable_shared_from_this<Socket> {
+  struct Message {
+    std::string bytes;
+    bool binary = false, counted = true;  // counted: a text, not a frame's part (which the next replaces)
+  };
+  Socket(State& owner, beast::tcp_stream&& stream) : state(owner), ws(std::move(stream)) {}
+  State& state;
   websocket::stream<beast::tcp_stream> ws;
-  int id;
+  int id = 0;
   beast::flat_buffer in;
   Clock::time_point heard = Clock::now(), progress = Clock::now();
   bool spoke = false, writing = false, closed = false;
-  std::deque<std::pair<std::string, bool>> batch;  // messages being written (binary: true)
-  std::size_t batch_text_bytes = 0;                 // the batch's bytes but its frame's
+  std::deque<Message> out;
+  std::size_t out_bytes = 0;
+  std::string status, data;  // the newest frame, when `frame`
+  bool frame = false;
 
   std::string name() const { return "page " + std::to_string(id); }
-  void read();
+  void read() {
+    ws.async_read(in, [self = shared_from_this()](error_code error, std::size_t) { self->on_read(error); });
+  }
   void on_read(error_code error);
-  void write_next();
-  void drop(const std::string& line);
-  void gone();
+  void send(const std::string& text) {
+    out.push_back({text});
+    out_bytes += text.size();
+    if (out_bytes > kOutboxBytes) {
+      return drop("live: " + name() + " dropped: over " + std::to_string(kOutboxBytes >> 20) +
+                  " MB waiting for it (it reads too little of what it asks for)");
+    }
+    write_next();
+  }
+  void write_next() {
+    if (writing || closed) return;
+    if (out.empty() && std::exchange(frame, false)) {
+      out.push_back({std::move(status), false, false});
+      out.push_back({std::move(data), true, false});
+    }
+    if (out.empty()) return;
+    writing = true;
+    progress = Clock::now();
+    ws.binary(out.front().binary);
+    ws.async_write(net::buffer(out.front().bytes), [self = shared_from_this()](error_code error, std::size_t) {
+      if (error) return self->gone();
+      if (self->out.front().counted) self->out_bytes -= self->out.front().bytes.size();
+      self->out.pop_front();
+      self->writing = false;
+      self->write_next();
+    });
+  }
+  void drop(const std::string& line) {
+    if (closed) return;
+    live_log(line);
+    beast::get_lowest_layer(ws).close();  // its pending read and write end with an error
+    gone();
+  }
+  void gone() {
+    if (closed) return;
+    closed = true;
+    const auto self = shared_from_this();
+    state.sockets.erase(id);
+    state.inbound(LiveInbound{id, {}, true, false});
+  }
 };
 
-void LiveServer::Io::Request::refuse(http::status status, const std::string& body, const std::string& line) {
-  if (!line.empty()) live_log(line);
-  respond(status, "text/plain; charset=utf-8", body + "\n");
-}
-
-void LiveServer::Io::Request::respond(http::status status, const char* type, std::string body) {
-  answered = true;
-  answer = http::response<http::string_body>(status, 11);
-  answer.set(http::field::content_type, type);
-  answer.set(http::field::cache_control, "no-store");
-  if (status == http::status::service_unavailable) answer.set(http::field::retry_after, "1");
-  answer.keep_alive(false);
-  answer.body() = std::move(body);
-  answer.prepare_payload();
-  stream.expires_after(millis(kStalledSeconds));
-  http::async_write(stream, answer, [self = shared_from_this()](error_code error, std::size_t) {
-    if (error) return self->stream.close();
-    self->stream.socket().shutdown(tcp::socket::shutdown_send, error);
-    self->stream.expires_after(std::chrono::seconds(2));
-    self->discard();  // what the client still sends is read and dropped: closing on it would reset the answer away
-  });
-}
-
-void LiveServer::Io::Request::discard() {
-  stream.async_read_some(net::buffer(drain), [self = shared_from_this()](error_code error, std::size_t) {
-    if (error) return self->stream.close();
-    self->discard();
-  });
-}
-
-void LiveServer::Io::Request::on_head(error_code error, std::size_t size) {
-  if (error == net::error::not_found) return refuse(http::status::request_header_fields_too_large, "live: a request head over 8 KiB");
+void LiveServer::State::Request::on_head(error_code error, std::size_t size) {
+  using status = http::status;
+  if (error == net::error::not_found) return respond(status::request_header_fields_too_large, "live: a request head over 8 KiB\n");
   if (error) return;  // closed, reset, or silent for kRequestSeconds: its slot goes to the next one
   const std::string raw = head.substr(0, size);
-  if (live_head_folded(raw)) return refuse(http::status::bad_request, "live: a folded header line (RFC 7230 §3.2.4)");
+  if (live_head_folded(raw)) return respond(status::bad_request, "live: a folded header line (RFC 7230 §3.2.4)\n");
   http::request_parser<http::empty_body> parser;
   parser.header_limit(static_cast<std::uint32_t>(kRequestCap));
   parser.put(net::buffer(raw), error);
-  if (error || !parser.is_header_done()) return refuse(http::status::bad_request, "live: a malformed request");
+  if (error || !parser.is_header_done()) return respond(status::bad_request, "live: a malformed request\n");
   const http::request<http::empty_body>& request = parser.get();
   std::string repeated;  // a header this server reads, given twice (which one counts is anybody's guess)
   std::set<std::string> seen;
   for (const auto& field : request) {
-    const std::string name = lower(std::string(field.name_string()));
+    std::string name(field.name_string());
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     const bool read = name == "host" || name == "origin" || name == "upgrade" || name.rfind("sec-websocket-", 0) == 0;
     if (read && !seen.insert(name).second) repeated = name;
   }
-  const int port = io.server->port();
-  if (request.method() != http::verb::get) return refuse(http::status::method_not_allowed, "live: only GET");
+  const int port = state.server->port();
+  if (request.method() != http::verb::get) return respond(status::method_not_allowed, "live: only GET\n");
   if (!repeated.empty()) {
-    return refuse(http::status::bad_request, "live: a header given twice (" + shown(repeated) + ")",
-                  "live: a request with two " + shown(repeated) + " headers, refused (400)");
+    return respond(status::bad_request, "live: a header given twice (" + repeated + ")\n",
+                   "live: a request with two " + shown(repeated) + " headers, refused (400)");
   }
   const auto host = request.find(http::field::host);
-  if (host == request.end()) return refuse(http::status::bad_request, "live: a request without Host");
+  if (host == request.end()) return respond(status::bad_request, "live: a request without Host\n");
   if (!live_host_allowed(std::string(host->value()), port)) {
-    return refuse(http::status::forbidden, "live: a request for another host",
-                  "live: a request for the host '" + shown(host->value()) + "', refused (403)");
+    return respond(status::forbidden, "live: a request for another host\n",
+                   "live: a request for the host '" + shown(host->value()) + "', refused (403)");
   }
   const std::string target(request.target());
   const std::size_t question = target.find('?');
   const std::string path = target.substr(0, question);
-  if (path != "/" && path != "/ws") return refuse(http::status::not_found, "live: not found (the page is /?token=...)");
+  if (path != "/" && path != "/ws") return respond(status::not_found, "live: not found (the page is /?token=...)\n");
   const bool upgrade = websocket::is_upgrade(request);
-  if (!live_token_matches(question == std::string::npos ? std::nullopt : std::optional<std::string>(target.substr(question + 1)),
-                          io.server->token())) {
-    return refuse(http::status::forbidden, "live: wrong or missing token (open the URL the program printed)",
-                  path == "/" && !upgrade ? "live: a request for the page without the run's token, refused (403)"
-                                          : "live: a WebSocket without the run's token, refused (403)");
+  const auto query = question == std::string::npos ? std::nullopt : std::optional<std::string>(target.substr(question + 1));
+  if (!live_token_matches(query, state.server->token())) {
+    return respond(status::forbidden, "live: wrong or missing token (open the URL the program printed)\n",
+                   path == "/" && !upgrade ? "live: a request for the page without the run's token, refused (403)"
+                                           : "live: a WebSocket without the run's token, refused (403)");
   }
-  if (path == "/") return respond(http::status::ok, "text/html; charset=utf-8", io.page);
+  if (path == "/") return respond(status::ok, state.page, "", "text/html; charset=utf-8");
   const auto origin = request.find(http::field::origin);
-  if (!live_origin_allowed(origin == request.end() ? std::nullopt : std::optional<std::string>(std::string(origin->value())), port)) {
-    return refuse(http::status::forbidden, "live: a WebSocket from a foreign Origin",
-                  "live: a WebSocket from the foreign Origin '" + shown(origin->value()) + "', refused (403)");
+  if (!live_origin_allowed(origin == request.end() ? std::nullopt : std::optional<std::string>(origin->value()), port)) {
+    return respond(status::forbidden, "live: a WebSocket from a foreign Origin\n",
+                   "live: a WebSocket from the foreign Origin '" + shown(origin->value()) + "', refused (403)");
   }
-  if (!upgrade) return refuse(http::status::bad_request, "live: /ws is a WebSocket (version 13)");
+  if (!upgrade) return respond(status::bad_request, "live: /ws is a WebSocket (version 13)\n");
   // A storm of reconnections costs the run a bounded amount a second, whatever its rate.
-  const Clock::time_point now = Clock::now();
-  if (since(io.window, now) >= 1.0) io.window = now, io.opened = 0;
-  if (++io.opened > kNewSocketsPerSecond) {
-    return refuse(http::status::service_unavailable, "live: too many new WebSockets this second; try again",
-                  "live: over " + std::to_string(kNewSocketsPerSecond) + " new WebSockets in a second, refused (503)");
+  if (since(state.window) >= 1.0) state.window = Clock::now(), state.opened = 0;
+  if (++state.opened > kNewSocketsPerSecond) {
+    return respond(status::service_unavailable, "live: too many new WebSockets this second; try again\n",
+                   "live: over " + std::to_string(kNewSocketsPerSecond) + " new WebSockets in a second, refused (503)");
   }
   answered = true;
   stream.expires_never();  // the WebSocket's own timeouts take over (Beast's idle timeout and pings)
-  beast::error_code ignored;
-  stream.socket().set_option(net::socket_base::send_buffer_size(static_cast<int>(kSendBufferBytes)), ignored);
-  auto socket = std::make_shared<Socket>(io, std::move(stream), 0);
+  stream.socket().set_option(net::socket_base::send_buffer_size(static_cast<int>(kSendBufferBytes)), error);
+  auto socket = std::make_shared<Socket>(state, std::move(stream));
   socket->ws.set_option(websocket::stream_base::timeout{millis(kRequestSeconds), millis(kSilentSeconds), true});
   socket->ws.read_message_max(kLiveMessageCap);
   socket->ws.auto_fragment(false);  // a message is one frame, as the page and the checks read it
@@ -321,146 +333,54 @@ void LiveServer::Io::Request::on_head(error_code error, std::size_t size) {
   });
   socket->ws.async_accept(request, [socket](error_code accept_error) {
     if (accept_error) return;  // Beast answered a bad handshake itself (400, 426)
-    Io& owner = socket->io;
+    State& owner = socket->state;
     if (static_cast<int>(owner.sockets.size()) >= kMaxClients) {
       // A reload or a new tab always connects: the oldest of the clients that never said a word makes
       // room, else the one heard from least recently.
-      auto rank = [](const std::shared_ptr<Socket>& other) { return std::make_pair(other->spoke, other->heard); };
-      auto quietest = std::min_element(owner.sockets.begin(), owner.sockets.end(),
-                                       [&rank](const auto& a, const auto& b) { return rank(a.second) < rank(b.second); });
-      quietest->second->drop("live: " + quietest->second->name() + " closed: a new page came and it was heard from least recently");
+      auto rank = [](const auto& entry) { return std::make_pair(entry.second->spoke, entry.second->heard); };
+      const auto quietest = std::min_element(owner.sockets.begin(), owner.sockets.end(),
+                                             [&rank](const auto& a, const auto& b) { return rank(a) < rank(b); })->second;
+      quietest->drop("live: " + quietest->name() + " closed: a new page came and it was heard from least recently");
     }
     socket->id = owner.next_client++;
     owner.sockets[socket->id] = socket;
-    {
-      const std::lock_guard<std::mutex> lock(owner.shared->mutex);
-      owner.shared->clients[socket->id].inbound.push_back(LiveInbound{socket->id, {}, false, true});
-    }
-    owner.shared->inbound_ready.notify_one();
+    owner.inbound(LiveInbound{socket->id, {}, false, true});
     socket->read();
   });
 }
 
-void LiveServer::Io::Socket::read() {
-  ws.async_read(in, [self = shared_from_this()](error_code error, std::size_t) { self->on_read(error); });
-}
-
-void LiveServer::Io::Socket::on_read(error_code error) {
-  if (error) {
-    if (error == websocket::error::message_too_big) {
-      live_log("live: " + name() + " closed: a message over " + std::to_string(kLiveMessageCap) + " bytes (close 1009)");
-    } else if (error != websocket::error::closed && error != net::error::operation_aborted && error != net::error::eof &&
-               error != net::error::connection_reset && !closed) {
-      live_log("live: " + name() + " closed: " + error.message());
-    }
-    return gone();
+void LiveServer::State::Socket::on_read(error_code error) {
+  if (error == websocket::error::message_too_big) {
+    live_log("live: " + name() + " closed: a message over " + std::to_string(kLiveMessageCap) + " bytes (close 1009)");
+  } else if (error && error != websocket::error::closed && error != net::error::operation_aborted &&
+             error != net::error::eof && error != net::error::connection_reset && !closed) {
+    live_log("live: " + name() + " closed: " + error.message());
   }
+  if (error) return gone();
   heard = Clock::now();
   spoke = true;
-  std::string text = beast::buffers_to_string(in.data());
-  in.consume(in.size());
   bool full = false;
-  {
-    const std::lock_guard<std::mutex> lock(io.shared->mutex);
-    Shared::Client& client = io.shared->clients[id];
-    if (ws.got_binary()) {
-      const std::string line = "live: a binary message, refused (a command is JSON text)";
-      live_log(line);
-      client.texts.push_back(error_message(line));
-      client.text_bytes += client.texts.back().size();
-    } else {
-      client.inbound.push_back(LiveInbound{id, std::move(text), false, false});
-    }
-    full = client.inbound.size() >= kInboundPerClient;
-    client.unread = full;  // read again once the loop has taken some (take_inbound, resume)
+  if (ws.got_binary()) {
+    const std::string line = "live: a binary message, refused (a command is JSON text)";
+    live_log(line);
+    send(live_json_text(nlohmann::json{{"type", "error"}, {"text", line}}));
+  } else {
+    state.inbound(LiveInbound{id, beast::buffers_to_string(in.data()), false, false}, &full);
   }
-  io.shared->inbound_ready.notify_one();
-  io.pump(id);
-  if (!full) read();
+  in.consume(in.size());
+  if (!full && !closed) read();
 }
 
-// The client's outbox into its socket, one message after another: texts first, then the newest frame.
-void LiveServer::Io::pump(int client) {
-  const auto found = sockets.find(client);
-  if (found == sockets.end() || found->second->writing || found->second->closed) return;
-  Socket& socket = *found->second;
-  {
-    const std::lock_guard<std::mutex> lock(shared->mutex);
-    Shared::Client& outbox = shared->clients[client];
-    for (std::string& text : outbox.texts) socket.batch.emplace_back(std::move(text), false);
-    socket.batch_text_bytes = outbox.text_bytes;
-    outbox.texts.clear();
-    outbox.text_bytes = 0;
-    if (outbox.frame) {
-      socket.batch.emplace_back(std::move(outbox.status), false);
-      socket.batch.emplace_back(std::move(outbox.data), true);
-      outbox.frame = false;
-    }
-  }
-  if (socket.batch.empty()) return;
-  socket.writing = true;
-  socket.progress = Clock::now();
-  socket.write_next();
-}
-
-void LiveServer::Io::Socket::write_next() {
-  if (batch.empty()) {
-    writing = false;
-    batch_text_bytes = 0;
-    return io.pump(id);
-  }
-  ws.binary(batch.front().second);
-  ws.async_write(net::buffer(batch.front().first), [self = shared_from_this()](error_code error, std::size_t) {
-    if (error) return self->gone();
-    self->progress = Clock::now();
-    const std::size_t size = self->batch.front().first.size();
-    self->batch_text_bytes -= std::min(self->batch_text_bytes, size);
-    self->batch.pop_front();
-    self->write_next();
-  });
-}
-
-void LiveServer::Io::Socket::drop(const std::string& line) {
-  if (closed) return;
-  live_log(line);
-  beast::get_lowest_layer(ws).close();  // its pending read and write end with an error: gone()
-  gone();
-}
-
-void LiveServer::Io::Socket::gone() {
-  if (closed) return;
-  closed = true;
-  io.sockets.erase(id);
-  {
-    const std::lock_guard<std::mutex> lock(io.shared->mutex);
-    Shared::Client& client = io.shared->clients[id];
-    client.gone = true;
-    client.texts.clear();
-    client.frame = false;
-    client.inbound.push_back(LiveInbound{id, {}, true, false});
-  }
-  io.shared->inbound_ready.notify_one();
-}
-
-void LiveServer::Io::resume(int client) {
-  const auto found = sockets.find(client);
-  if (found != sockets.end() && !found->second->closed) found->second->read();
-}
-
-void LiveServer::Io::accept() {
+void LiveServer::State::accept() {
   acceptor.async_accept(context, [this](error_code error, tcp::socket socket) {
     if (error == net::error::operation_aborted) return;
     if (error) {  // out of descriptors, say: try again shortly rather than spin
       retry.expires_after(std::chrono::milliseconds(50));
       return retry.async_wait([this](error_code) { accept(); });
     }
-    beast::error_code ignored;
     // A frame is two writes (its status, then its data): with Nagle's algorithm the second waited for the page's delayed ACK.
-    socket.set_option(tcp::no_delay(true), ignored);
-    pending.remove_if([](const std::weak_ptr<Request>& request) {
-      const auto held = request.lock();
-      return !held || held->answered;
-    });
+    socket.set_option(tcp::no_delay(true), error);
+    pending.remove_if([](const std::weak_ptr<Request>& request) { return request.expired() || request.lock()->answered; });
     if (static_cast<int>(pending.size()) >= kMaxPending) {  // the newest comer gets the slot: a reload always can
       if (const auto oldest = pending.front().lock()) oldest->stream.close();
       pending.pop_front();
@@ -472,159 +392,144 @@ void LiveServer::Io::accept() {
   });
 }
 
-// Every quarter second: a client whose writes made no progress for kStalledSeconds, or with over
-// kOutboxBytes waiting for it (every byte but its frame, which the next replaces), is dropped.
-void LiveServer::Io::check_sockets() {
-  const Clock::time_point now = Clock::now();
-  std::vector<std::pair<std::shared_ptr<Socket>, std::string>> drops;
+// Every quarter second: a client whose writes made no progress for kStalledSeconds is dropped.
+void LiveServer::State::check_stalls() {
+  std::vector<std::shared_ptr<Socket>> stalled;
   for (const auto& [id, socket] : sockets) {
-    std::size_t queued = socket->batch_text_bytes;
-    {
-      const std::lock_guard<std::mutex> lock(shared->mutex);
-      queued += shared->clients[id].text_bytes;
-    }
-    if (queued > kOutboxBytes) {
-      drops.emplace_back(socket, "live: " + socket->name() + " dropped: over " + std::to_string(kOutboxBytes >> 20) +
-                                     " MB waiting for it (it reads too little of what it asks for)");
-    } else if (socket->writing && since(socket->progress, now) > kStalledSeconds) {
-      drops.emplace_back(socket, "live: " + socket->name() + " dropped: it took nothing off its socket for " +
-                                     std::to_string(int(kStalledSeconds)) + " s");
-    }
+    if (socket->writing && since(socket->progress) > kStalledSeconds) stalled.push_back(socket);
   }
-  for (auto& [socket, line] : drops) socket->drop(line);
+  for (const auto& socket : stalled) {
+    socket->drop("live: " + socket->name() + " dropped: it took nothing off its socket for " +
+                 std::to_string(int(kStalledSeconds)) + " s");
+  }
   sweep.expires_after(std::chrono::milliseconds(250));
   sweep.async_wait([this](error_code error) {
-    if (!error) check_sockets();
+    if (!error) check_stalls();
   });
 }
 
-LiveServer::LiveServer(int port, std::string page)
-    : token_(live_token()), shared_(std::make_unique<Shared>()), io_(std::make_unique<Io>()) {
+LiveServer::LiveServer(int port, std::string page) : token_(live_token()), state_(std::make_unique<State>()) {
+  State& state = *state_;
   const tcp::endpoint endpoint(net::ip::address_v4::loopback(), static_cast<unsigned short>(port));
   error_code error;
-  io_->acceptor.open(endpoint.protocol(), error);
-  if (!error) io_->acceptor.set_option(net::socket_base::reuse_address(true), error);
-  if (!error) io_->acceptor.bind(endpoint, error);
-  if (!error) io_->acceptor.listen(128, error);
+  state.acceptor.open(endpoint.protocol(), error);
+  if (!error) state.acceptor.set_option(net::socket_base::reuse_address(true), error);
+  if (!error) state.acceptor.bind(endpoint, error);
+  if (!error) state.acceptor.listen(128, error);
   if (error) throw InputError("--live: cannot listen on 127.0.0.1:" + std::to_string(port) + " (" + error.message() + ")");
-  port_ = io_->acceptor.local_endpoint().port();
-  io_->server = this;
-  io_->shared = shared_.get();
-  io_->page = std::move(page);
-  io_->signals.async_wait([shared = shared_.get()](error_code signal_error, int) {
+  port_ = state.acceptor.local_endpoint().port();
+  state.server = this;
+  state.page = std::move(page);
+  state.signals.async_wait([&state](error_code signal_error, int) {
     if (signal_error) return;
-    shared->stop = true;
-    shared->inbound_ready.notify_all();
+    state.stop = true;
+    state.inbound_ready.notify_all();
   });
-  io_->accept();
-  io_->check_sockets();
-  io_->thread = std::thread([io = io_.get()] { io->context.run(); });
+  state.accept();
+  state.check_stalls();
+  state.thread = std::thread([&state] { state.context.run(); });
 }
 
 LiveServer::~LiveServer() {
-  io_->context.stop();
-  io_->thread.join();
-  io_->sockets.clear();
-  io_->pending.clear();
+  state_->context.stop();
+  state_->thread.join();
+  state_->sockets.clear();
+  state_->pending.clear();
 }
 
 std::string LiveServer::url() const { return "http://127.0.0.1:" + std::to_string(port_) + "/?token=" + token_; }
 
-bool LiveServer::stop_requested() const { return shared_->stop; }
+bool LiveServer::stop_requested() const { return state_->stop; }
 
 std::vector<LiveInbound> LiveServer::take_inbound() {
   std::vector<LiveInbound> taken;
   std::vector<int> unread;
   {
-    const std::lock_guard<std::mutex> lock(shared_->mutex);
-    auto& clients = shared_->clients;
-    std::size_t turns = clients.size();
-    auto client = clients.upper_bound(shared_->last_taken);
-    for (; turns > 0 && taken.size() < kTakePerTurn; --turns) {
-      if (client == clients.end()) client = clients.begin();
-      std::deque<LiveInbound>& queue = client->second.inbound;
+    const std::lock_guard<std::mutex> lock(state_->mutex);
+    auto& inboxes = state_->inboxes;
+    auto inbox = inboxes.upper_bound(state_->last_taken);
+    for (std::size_t turns = inboxes.size(); turns > 0 && taken.size() < kTakePerTurn; --turns) {
+      if (inbox == inboxes.end()) inbox = inboxes.begin();
+      std::deque<LiveInbound>& queue = inbox->second.inbound;
       bool closed = false;
       for (std::size_t k = 0; k < kTakePerClient && !queue.empty() && taken.size() < kTakePerTurn; ++k) {
         closed = queue.front().closed;
         // A page that came and has gone already costs the loop nothing: no hello is built for it.
-        if (!(queue.front().opened && client->second.gone)) taken.push_back(std::move(queue.front()));
+        if (!(queue.front().opened && inbox->second.gone)) taken.push_back(std::move(queue.front()));
         queue.pop_front();
       }
-      if (client->second.unread && queue.size() < kInboundPerClient) {
-        client->second.unread = false;
-        unread.push_back(client->first);
-      }
-      shared_->last_taken = client->first;
-      client = closed ? clients.erase(client) : std::next(client);
+      if (inbox->second.unread && queue.size() < kInboundPerClient) inbox->second.unread = false, unread.push_back(inbox->first);
+      state_->last_taken = inbox->first;
+      inbox = closed ? inboxes.erase(inbox) : std::next(inbox);
     }
   }
   if (!unread.empty()) {  // the server reads again from a client it had stopped reading
-    net::post(io_->context, [io = io_.get(), unread] {
-      for (const int client : unread) io->resume(client);
+    state_->post([state = state_.get(), unread] {
+      for (const int id : unread) {
+        if (state->sockets.count(id)) state->sockets[id]->read();
+      }
     });
   }
   return taken;
 }
 
 void LiveServer::wait_inbound(double seconds) {
-  std::unique_lock<std::mutex> lock(shared_->mutex);
-  if (seconds <= 0.0 || shared_->stop) return;
-  for (const auto& [id, client] : shared_->clients) {
-    if (!client.inbound.empty()) return;
+  std::unique_lock<std::mutex> lock(state_->mutex);
+  if (seconds <= 0.0 || state_->stop) return;
+  for (const auto& [id, inbox] : state_->inboxes) {
+    if (!inbox.inbound.empty()) return;
   }
-  shared_->inbound_ready.wait_for(lock, std::chrono::duration<double>(seconds));
+  state_->inbound_ready.wait_for(lock, std::chrono::duration<double>(seconds));
 }
 
 void LiveServer::send_text(int client, const std::string& text) {
-  {
-    const std::lock_guard<std::mutex> lock(shared_->mutex);
-    for (auto& [id, entry] : shared_->clients) {
-      if ((client >= 0 && id != client) || entry.gone) continue;
-      entry.texts.push_back(text);
-      entry.text_bytes += text.size();
+  state_->post([state = state_.get(), client, text] {
+    std::vector<std::shared_ptr<State::Socket>> to;
+    for (const auto& [id, socket] : state->sockets) {
+      if (client < 0 || id == client) to.push_back(socket);
     }
-  }
-  net::post(io_->context, [io = io_.get(), client] {
-    if (client >= 0) return io->pump(client);
-    std::vector<int> all;
-    for (const auto& [id, socket] : io->sockets) all.push_back(id);
-    for (const int id : all) io->pump(id);
+    for (const auto& socket : to) socket->send(text);
   });
 }
 
 std::vector<int> LiveServer::ready_clients() {
-  const std::lock_guard<std::mutex> lock(shared_->mutex);
+  const std::lock_guard<std::mutex> lock(state_->mutex);
   std::vector<int> ready;
-  for (const auto& [id, entry] : shared_->clients) {
-    if (!entry.gone && entry.in_flight < kFramesInFlight) ready.push_back(id);
+  for (const auto& [id, inbox] : state_->inboxes) {
+    if (!inbox.gone && inbox.in_flight < kFramesInFlight) ready.push_back(id);
   }
   return ready;
 }
 
 void LiveServer::send_frame(int client, const std::string& text, const std::vector<float>& frame) {
   {
-    const std::lock_guard<std::mutex> lock(shared_->mutex);
-    const auto found = shared_->clients.find(client);
-    if (found == shared_->clients.end() || found->second.gone) return;
-    found->second.status = text;
-    found->second.data.assign(reinterpret_cast<const char*>(frame.data()), frame.size() * sizeof(float));
-    found->second.frame = true;
+    const std::lock_guard<std::mutex> lock(state_->mutex);
+    const auto found = state_->inboxes.find(client);
+    if (found == state_->inboxes.end() || found->second.gone) return;
     ++found->second.in_flight;
   }
-  net::post(io_->context, [io = io_.get(), client] { io->pump(client); });
+  std::string data(reinterpret_cast<const char*>(frame.data()), frame.size() * sizeof(float));
+  state_->post([state = state_.get(), client, text, data = std::move(data)]() mutable {
+    const auto found = state->sockets.find(client);
+    if (found == state->sockets.end()) return;
+    State::Socket& socket = *found->second;
+    socket.status = text;
+    socket.data = std::move(data);
+    socket.frame = true;  // a frame still waiting is replaced: the newest wins
+    socket.write_next();
+  });
 }
 
 void LiveServer::acknowledge(int client) {
-  const std::lock_guard<std::mutex> lock(shared_->mutex);
-  const auto found = shared_->clients.find(client);
-  if (found != shared_->clients.end() && found->second.in_flight > 0) --found->second.in_flight;
+  const std::lock_guard<std::mutex> lock(state_->mutex);
+  const auto found = state_->inboxes.find(client);
+  if (found != state_->inboxes.end() && found->second.in_flight > 0) --found->second.in_flight;
 }
 
 int LiveServer::clients() {
-  const std::lock_guard<std::mutex> lock(shared_->mutex);
-  int count = 0;
-  for (const auto& [id, entry] : shared_->clients) count += entry.gone ? 0 : 1;
-  return count;
+  const std::lock_guard<std::mutex> lock(state_->mutex);
+  return static_cast<int>(std::count_if(state_->inboxes.begin(), state_->inboxes.end(),
+                                        [](const auto& entry) { return !entry.second.gone; }));
 }
 
 }  // namespace cl

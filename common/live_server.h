@@ -1,30 +1,16 @@
 #pragma once
-// The live mode's server (docs/DESIGN.md §3, "The live mode"): Boost.Beast
-// over Asio, one io_context thread, on 127.0.0.1 only. Beast owns HTTP and
-// RFC 6455 (parsing, framing, the message cap, UTF-8 of text and close
-// frames, close codes, pings); this file is the course's policy: who may
-// connect and what each client is sent.
-//
-// GET /?token=T serves the page, /ws?token=T is the page's WebSocket; neither
-// answers without the run's token (403). A request whose Host is not this
-// server's (403), one that gives a header the server reads twice or a folded
-// header line (400), a head over kRequestCap (431), a WebSocket whose Origin
-// is not this server's (403) and more than kNewSocketsPerSecond new
-// WebSockets in a second (503) are refused too.
-//
-// One slow or noisy client must never stall the run or another client, so:
-// the live loop (common/live.h) never touches a socket (it fills per-client
-// outboxes; a frame waiting replaces the one before, the newest wins); a
-// client whose writes make no progress for kStalledSeconds, or with more than
-// kOutboxBytes queued toward it (everything but its frame), is dropped with
-// one line; each client's messages wait in its own queue of at most
-// kInboundPerClient, and while it is full the server reads no more from that
-// client (TCP holds the rest, so nothing is lost, an ack included);
-// take_inbound takes from every client in turn, at most kTakePerTurn events,
-// and never tells of a page that came and has gone already. Connections are
-// bounded: kMaxClients WebSockets (a new one evicts the one heard from least
-// recently), kMaxPending connections still sending their request (a new one
-// evicts the oldest), each given kRequestSeconds to send it.
+// The live mode's server (docs/DESIGN.md §3, "The live mode", says where each
+// limit lives): Boost.Beast over Asio, one io_context thread, on 127.0.0.1
+// only. Beast owns HTTP and RFC 6455; this is the course's policy. GET
+// /?token=T serves the page, /ws?token=T is its WebSocket; a wrong token, Host
+// or Origin is refused (403), as are a header read twice or a folded line
+// (400), a head over kRequestCap (431) and more than kNewSocketsPerSecond new
+// WebSockets a second (503). The live loop (common/live.h) never touches a
+// socket: it fills per-client outboxes, where the newest frame replaces the
+// one waiting; a client that takes nothing for kStalledSeconds, or has over
+// kOutboxBytes waiting (its frame aside), is dropped; its messages wait in a
+// queue of kInboundPerClient, and while that is full it is not read (TCP
+// holds the rest, none is lost).
 #include <cstddef>
 #include <memory>
 #include <optional>
@@ -92,14 +78,12 @@ class LiveServer {
   static constexpr double kStalledSeconds = 5.0;
   static constexpr double kSilentSeconds = 20.0;  // Beast's idle timeout: pinged at half, closed at the end
 
-  struct Shared;  // what the live loop and the server's thread share (live_server.cpp)
-  struct Io;      // the server thread's own state
+  struct State;  // the queues both threads share, and the server thread's own (live_server.cpp)
 
  private:
   std::string token_;
   int port_ = 0;
-  std::unique_ptr<Shared> shared_;
-  std::unique_ptr<Io> io_;
+  std::unique_ptr<State> state_;
 };
 
 // 128 random bits as 32 hex digits (std::random_device).
