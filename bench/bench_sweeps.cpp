@@ -22,7 +22,6 @@
 // XPBD is timed as whole steps of K = 20 sweeps (the reference's sweep is
 // inside xpbd_step), so its figure carries 1/20 of a step's own work
 // (prediction, α̃ per spring, the checks).
-#include <omp.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -34,6 +33,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include "common/openmp.h"
 #include "common/scene.h"
 #include "gauss_seidel.h"
 #include "jacobi.h"
@@ -144,8 +144,8 @@ template <bool kCalling>
 void jacobi(benchmark::State& state) {
   const cl::Scene scene = cloth(static_cast<int>(state.range(0)));
   const int threads = kCalling ? 1 : static_cast<int>(state.range(1));
-  const int saved = omp_get_max_threads();
-  omp_set_num_threads(threads);
+  const int saved = cl::openmp_max_threads();
+  cl::set_openmp_threads(threads);
   const cl::lab03::Incidence incidence = cl::lab03::build_incidence(scene.particles.size(), scene.springs);
   Eigen::Matrix3Xd x = scene.particles.x;
   Eigen::Matrix3Xd x_next = x;
@@ -160,7 +160,7 @@ void jacobi(benchmark::State& state) {
     benchmark::DoNotOptimize(x.data());
     benchmark::ClobberMemory();
   }
-  omp_set_num_threads(saved);
+  cl::set_openmp_threads(saved);
   state.counters["threads"] = threads;
   count_springs(state, static_cast<double>(scene.springs.size()), 2.0);
 }

@@ -33,7 +33,6 @@
 #include <unistd.h>
 
 #ifdef _OPENMP
-#include <omp.h>
 #endif
 
 #include <Eigen/Core>
@@ -42,6 +41,7 @@
 #include "common/csv.h"
 #include "common/health.h"
 #include "common/metrics.h"
+#include "common/openmp.h"
 #include "common/output.h"
 #include "common/scene.h"
 #include "common/sparse.h"
@@ -387,7 +387,7 @@ int run(const Options& options) {
   const int long_steps = options.long_steps > 0 ? options.long_steps : (options.quick ? 2 : 12);
   cl::start_run(options.out);
 #ifdef _OPENMP
-  omp_set_num_threads(options.threads);
+  cl::set_openmp_threads(options.threads);
   cl::set_blas_threads(options.threads);  // CHOLMOD's BLAS too: serial methods, timed side by side
 #endif
   const cl::Scene base = base_scene();

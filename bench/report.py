@@ -7,7 +7,7 @@ reads DIR/trade.csv, trade_scenes.csv, trade_fastest.csv, trade_scaling.csv,
 trade_contact.csv (when the run had the drape) and DIR/trade.log (the
 program's terminal output, for the run's length and settings; optional), and
 replaces the text between the results markers of bench/README.md and between
-the trade markers of README.md. Every number between the markers is this
+the trade markers of docs/instructor.md. Every number between the markers is this
 run's: the pages say so, and nothing there is edited by hand. --machine says
 what the run shared the machine with (the load), which no CSV records.
 The run's end is trade.csv's modification time; a copied folder loses it
@@ -478,7 +478,7 @@ def main(argv):
         print("\n".join(bench_section(run, args.machine) + [""] + readme_section(run)))
         return 0
     replace_between(ROOT / "bench" / "README.md", BENCH_MARKERS, bench_section(run, args.machine))
-    replace_between(ROOT / "README.md", README_MARKERS, readme_section(run))
+    replace_between(ROOT / "docs" / "instructor.md", README_MARKERS, readme_section(run))
     if args.extremes:
         replace_between(ROOT / "bench" / "README.md", EXTREMES_MARKERS, extremes_section(Path(args.extremes), ""))
     return 0

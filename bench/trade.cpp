@@ -28,7 +28,6 @@
 #include <unistd.h>
 
 #ifdef _OPENMP
-#include <omp.h>
 #endif
 
 #include <Eigen/Core>
@@ -37,6 +36,7 @@
 #include "common/csv.h"
 #include "common/health.h"
 #include "common/metrics.h"
+#include "common/openmp.h"
 #include "common/output.h"
 #include "common/scene.h"
 #include "common/sparse.h"
@@ -666,7 +666,7 @@ int run(const Options& options) {
   }
   cl::start_run(options.out);
 #ifdef _OPENMP
-  omp_set_num_threads(options.threads);
+  cl::set_openmp_threads(options.threads);
   cl::set_blas_threads(options.threads);  // CHOLMOD's BLAS too: serial methods, timed side by side
 #endif
 

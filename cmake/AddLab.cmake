@@ -337,11 +337,18 @@ extern "C" const char cl_student_earlier_labs[] = "@student_earlier@";
   set(${out} "${path}" PARENT_SCOPE)
 endfunction()
 
-# Called once the whole CMakeLists.txt is read (cmake_language DEFER): labs.json.
+# Called once the whole CMakeLists.txt is read (cmake_language DEFER): labs.json,
+# with what the build has that grading depends on ("build": OpenMP, and the
+# Catch2 version's major number).
 function(_cl_write_lab_manifest)
   get_property(entries GLOBAL PROPERTY CL_LAB_MANIFEST)
   list(JOIN entries ",\n" body)
+  if(CL_HAVE_OPENMP)
+    set(openmp true)
+  else()
+    set(openmp false)
+  endif()
   file(CONFIGURE OUTPUT "${PROJECT_BINARY_DIR}/labs.json"
-       CONTENT "{\n  \"labs\": {\n${body}\n  }\n}\n" @ONLY)
+       CONTENT "{\n  \"build\": {\"openmp\": ${openmp}, \"catch2\": ${CL_CATCH2_MAJOR}},\n  \"labs\": {\n${body}\n  }\n}\n" @ONLY)
 endfunction()
 cmake_language(DEFER CALL _cl_write_lab_manifest)

@@ -71,8 +71,10 @@ int max_levels(int nx, int ny);
 //   springs         the cloth's own constraints, copied to level 0.
 //
 // Masses: a coarse particle starts with its own (finer-level) mass and gets
-// weight · m of every movable finer particle it parents, so each level has the
-// total movable mass of the cloth. A particle pinned on the finer level is
+// weight · m of every movable finer particle it parents (the weights of a
+// finer particle sum to 1). The share that lands on a pinned coarse particle
+// no longer moves, so next to pins a level's movable mass is a little below
+// the finer one's (lab 10's run prints each level's). A particle pinned on the finer level is
 // pinned on every level it is on (inverse mass 0 stays 0); a pinned particle
 // that is not on the coarser level passes no mass up (it never moves).
 //

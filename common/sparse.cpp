@@ -10,7 +10,9 @@
 #include <utility>
 #include <vector>
 
-#include <dlfcn.h>
+#ifndef _WIN32
+#include <dlfcn.h>  // the BLAS's and OpenMP's setters, looked up at run time
+#endif
 
 #ifdef CL_HAVE_CHOLMOD
 #include <cholmod.h>
@@ -25,11 +27,15 @@ std::atomic<bool> blas_threads_chosen{false};
 bool set_blas_threads(int threads) {
   if (threads < 1) throw std::invalid_argument("set_blas_threads: threads " + std::to_string(threads) + " < 1");
   blas_threads_chosen = true;
+#ifdef _WIN32
+  return false;  // no run-time lookup there; only CHOLMOD's supernodal factor calls the BLAS
+#else
   void* symbol = dlsym(RTLD_DEFAULT, "openblas_set_num_threads");
   if (symbol == nullptr) return false;
   using SetThreads = void (*)(int);
   reinterpret_cast<SetThreads>(symbol)(threads);
   return true;
+#endif
 }
 
 namespace {

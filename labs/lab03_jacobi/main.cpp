@@ -2,7 +2,6 @@
 // gauss-seidel, lab 02's sweeps in file order, for the side-by-side
 // comparison), with the strain error, the change in positions and the wall
 // time of every sweep. Divergence (ω ≥ 2) is a reported outcome, not a failure.
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +14,7 @@
 
 #include "common/cli.h"
 #include "common/driver.h"
+#include "common/openmp.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "common/timer.h"
@@ -43,8 +43,17 @@ double median(std::vector<double> values) {
 
 int run(const cl::CommonOptions& options, const LabOptions& lab) {
   const cl::Scene scene = cl::load_scene_for(options, CL_LAB_SCENE_DIR);
-  cl::start_run(options);
+  // Without a spring every sweep is empty: "converged" would say nothing.
+  if (scene.springs.empty()) throw cl::InputError(scene.source + ": no springs: a sweep has nothing to project");
   const bool jacobi = options.method == "jacobi";
+  if (cl::check_mode()) {  // a sweep lab: sweeps, not time steps, and what shapes them
+    std::string line = ", " + std::to_string(options.iterations) + " sweeps, --method " + options.method;
+    if (jacobi) line += ", --omega " + cl::format_double(lab.omega) + ", --averaging " + lab.averaging;
+    if (!options.out.empty()) line += ", writes " + options.out + "/";
+    if (!options.summary.empty()) line += ", summary " + options.summary;
+    throw cl::CheckStop{line};
+  }
+  cl::start_run(options);
   const cl::lab03::Averaging averaging =
       lab.averaging == "none" ? cl::lab03::Averaging::kNone : cl::lab03::Averaging::kByCount;
   const Eigen::VectorXd& inv_mass = scene.particles.inv_mass;
@@ -53,7 +62,7 @@ int run(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("%s: scene %s, %ld particles, %zu springs, %d ", kLab, scene.name.c_str(),
               static_cast<long>(scene.particles.size()), spring_count, options.iterations);
   if (jacobi) {
-    omp_set_num_threads(lab.threads);
+    cl::set_openmp_threads(lab.threads);
     std::printf("Jacobi sweeps (omega %g, %s, %d thread%s)\n", lab.omega,
                 averaging == cl::lab03::Averaging::kByCount ? "averaged by count" : "summed, no averaging",
                 lab.threads, lab.threads == 1 ? "" : "s");
@@ -160,22 +169,27 @@ int main(int argc, char** argv) {
   options.method = "jacobi";
   options.methods = {"jacobi", "gauss-seidel"};
   options.frames_are_sweeps = true;
+  options.steps = 0;  // no time steps: the scene's dt and steps are not read
   cl::add_common_options(app, options,
                          cl::kFlagScene | cl::kFlagMethod | cl::kFlagIterations | cl::kFlagOut | cl::kFlagSummary |
                              cl::kFlagFrames);
   app.get_option("--iterations").description("sweeps over all springs (this lab has no time steps)");
   LabOptions lab;
-  lab.threads = omp_get_max_threads();
-  app.add_option("--omega", lab.omega, "Jacobi relaxation factor (0 leaves x unchanged; >= 2 diverges)")
+  lab.threads = cl::openmp_max_threads();
+  // Only the Jacobi sweep reads these: with --method gauss-seidel they are refused, not ignored.
+  app.add_option("--omega", lab.omega, "Jacobi relaxation factor (0 leaves x unchanged; 0 < omega < 2 converges)")
       .non_negative()
-      .capture_default_str();
+      .capture_default_str()
+      .only_for_methods({"jacobi"});
   app.add_option("--threads", lab.threads, "OpenMP threads for the Jacobi sweep")
       .range(1, 1024)
-      .capture_default_str();
+      .capture_default_str()
+      .only_for_methods({"jacobi"});
   app.add_option("--averaging", lab.averaging,
                  "count: divide each particle's summed correction by its spring count; none: plain summed Jacobi")
       .one_of({"count", "none"})
-      .capture_default_str();
+      .capture_default_str()
+      .only_for_methods({"jacobi"});
   app.add_option("--tolerance", lab.tolerance, "max strain error that counts as converged")
       .positive()
       .capture_default_str();

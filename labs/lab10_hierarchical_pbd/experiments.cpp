@@ -21,13 +21,13 @@ std::string join(const std::vector<int>& values, const char* separator) {
   return text;
 }
 
-ClothHierarchy hierarchy_for(const Scene& scene, int levels) {
+ClothHierarchy hierarchy_for(const Scene& scene, int levels, const std::string& flag) {
   if (scene.grid_nx < 2 || scene.grid_ny < 2) {
     throw cl::InputError("--scene " + scene.name + ": hierarchical PBD needs a cloth grid (a scene with \"cloth\")");
   }
   const int most = cl::max_levels(scene.grid_nx, scene.grid_ny);
   if (levels > most) {
-    throw cl::InputError("--levels: " + std::to_string(levels) + " is more than a " + std::to_string(scene.grid_nx) +
+    throw cl::InputError(flag + ": " + std::to_string(levels) + " is more than a " + std::to_string(scene.grid_nx) +
                          " x " + std::to_string(scene.grid_ny) + " grid has (at most " + std::to_string(most) + ")");
   }
   return cl::build_cloth_hierarchy(scene.grid_nx, scene.grid_ny, scene.particles.x, scene.particles.inv_mass,
@@ -56,13 +56,14 @@ int sweep_limit(const LabOptions& lab, const cl::Scene& scene) {
 int run_converge(const char* lab_name, const std::string& scene_dir, const CommonOptions& options,
                  const LabOptions& lab) {
   const std::vector<int> level_counts = lab.sweep_levels.empty() ? std::vector<int>{lab.levels} : lab.sweep_levels;
+  const std::string levels_flag = lab.sweep_levels.empty() ? "--levels" : "--sweep-levels";
   if (level_counts.size() > 1 && lab.iterations_per_level.size() != 1) {
     throw cl::InputError("--iterations-per-level: with several --sweep-levels give one count (for every level)");
   }
   const std::vector<cl::Scene> scenes = cl::load_scenes(options, lab.sweep_scenes, scene_dir);
   for (const cl::Scene& scene : scenes) {
     for (const int levels : level_counts) {  // reject bad input before any work
-      hierarchy_for(scene, levels);
+      hierarchy_for(scene, levels, levels_flag);
       if (per_level(lab, levels).front() < 1) {
         throw cl::InputError("--iterations-per-level: --converge needs at least 1 sweep on the cloth");
       }
@@ -92,9 +93,11 @@ int run_converge(const char* lab_name, const std::string& scene_dir, const Commo
       const std::vector<int> iterations = per_level(lab, levels);
       const std::string k = join(iterations, "/");  // a CSV cell: no commas
       const int max_sweeps = sweep_limit(lab, scene);
+      // Which cap stops a measurement that does not reach its target.
+      const char* limit = max_sweeps < lab.max_sweeps ? "--max-projections" : "--max-sweeps";
       const ConvergenceResult result = converge_one_step(
           scene.particles, hierarchy, scene.dt, scene.gravity, iterations, lab.targets, max_sweeps);
-      // About a hundred samples per decade of sweeps keep the CSV small.
+      // Every sweep below 200, then every (sweeps / 100)-th: the rows thin out as the sweeps grow.
       for (const ConvergenceSample& sample : result.samples) {
         const int step = std::max(1, sample.sweeps / 100);
         if (sample.sweeps % step != 0 && &sample != &result.samples.back()) continue;
@@ -113,7 +116,7 @@ int run_converge(const char* lab_name, const std::string& scene_dir, const Commo
                          static_cast<long long>(max_sweeps)});
         std::printf("%-18s %6d %9s %7.3g %11.4e %7d %8d %14lld %9.4f%s\n", scene.name.c_str(), levels, k.c_str(),
                     target.target, at.strain.max, at.passes, at.sweeps, at.projections, at.seconds,
-                    target.reached ? "" : "  not reached (the sweep limit)");
+                    target.reached ? "" : (std::string("  not reached (the limit of ") + limit + ")").c_str());
       }
       if (single && !options.summary.empty()) {
         const ConvergenceSample& last = result.samples.back();

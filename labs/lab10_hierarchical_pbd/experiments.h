@@ -30,8 +30,9 @@ const char* method_name(int levels);
 std::string join(const std::vector<int>& values, const char* separator = ",");
 
 // The hierarchy of `levels` levels on the scene's cloth. Throws InputError for
-// a scene without a cloth grid or more levels than its grid has.
-ClothHierarchy hierarchy_for(const Scene& scene, int levels);
+// a scene without a cloth grid or more levels than its grid has, naming `flag`
+// (the option that gave the level count: --levels, or --sweep-levels).
+ClothHierarchy hierarchy_for(const Scene& scene, int levels, const std::string& flag = "--levels");
 
 // --iterations-per-level: one count for every level, or one per level (the
 // cloth first). Throws InputError for any other number of counts.

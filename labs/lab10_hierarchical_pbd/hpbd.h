@@ -61,8 +61,8 @@ void prolong_corrections(Eigen::Matrix3Xd& x, const Eigen::Matrix3Xd& start,
 //
 // Shapes: x is 3 × n, every level's inv_mass has n entries. Throws
 // std::invalid_argument, before changing x, when iterations.size() differs
-// from the number of levels, an entry is negative, or x has the wrong number
-// of columns.
+// from the number of levels, an entry is negative, or the inv_mass of any
+// level, the coarse ones included, does not have x.cols() entries.
 void solve_hierarchy(Eigen::Matrix3Xd& x, const ClothHierarchy& hierarchy, const std::vector<int>& iterations);
 
 }  // namespace cl::lab10

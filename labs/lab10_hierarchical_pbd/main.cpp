@@ -90,10 +90,12 @@ int run_one(const cl::CommonOptions& options, const LabOptions& lab) {
   std::printf("%s: scene %s, %d level(s), sweeps per level %s (the cloth first), %d frames of %.4g s\n", kLab,
               describe_cloth(scene).c_str(), lab.levels, cl::lab10::join(settings.iterations).c_str(), scene.steps,
               scene.dt);
-  for (int l = 1; l < hierarchy.level_count(); ++l) {
+  for (int l = 0; l < hierarchy.level_count(); ++l) {
     const cl::HierarchyLevel& level = hierarchy.levels[static_cast<std::size_t>(l)];
-    std::printf("  level %d: %d x %d particles, %zu unilateral constraints\n", l, level.nx, level.ny,
-                level.springs.size());
+    double movable = 0.0;  // kg; a pinned particle's (and what it collects) never moves
+    for (const int p : level.particles) movable += level.inv_mass[p] > 0.0 ? 1.0 / level.inv_mass[p] : 0.0;
+    std::printf("  level %d: %d x %d particles, %zu %sconstraints, movable mass %.4g kg\n", l, level.nx, level.ny,
+                level.springs.size(), l > 0 ? "unilateral " : "", movable);
   }
   if (diverged) {
     cl::print_stopped("DIVERGED", "frame", result.problem_frame, scene.dt, result.problem);

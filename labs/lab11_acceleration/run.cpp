@@ -1,7 +1,5 @@
 #include "run.h"
 
-#include <omp.h>
-
 #include <cstdio>
 #include <optional>
 #include <utility>
@@ -9,6 +7,7 @@
 #include "../lab06_projective_dynamics/simulation.h"
 #include "common/driver.h"
 #include "common/metrics.h"
+#include "common/openmp.h"
 
 namespace cl::lab11 {
 
@@ -38,7 +37,7 @@ int run_live_scene(const char* lab_name, const std::string& scene_dir, const Com
   // One thread: the loop sleeps between steps, and on a busy machine each of a
   // Jacobi sweep's parallel regions waited for a descheduled thread (110 ms a
   // step of jacobi-chebyshev on pd-curtain-16 against 0.5 ms on one thread).
-  omp_set_num_threads(1);
+  cl::set_openmp_threads(1);
   const Method method = method_from_name(options.method);
   Scene scene = std::move(load(options, {}, method, scene_dir).front());
   start_run(options);  // --check stops here, before the estimate of rho runs your code

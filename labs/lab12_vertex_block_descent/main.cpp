@@ -8,7 +8,6 @@
 //                  seconds to each target
 //   --stability    experiment 2: the table of k × Δt × K on the scene (stability.csv)
 //   --live [PORT]  the scene's steps beside a page in the browser (run.cpp)
-#include <omp.h>
 
 #include <cmath>
 #include <cstdio>
@@ -18,6 +17,7 @@
 #include "common/cli.h"
 #include "common/csv.h"
 #include "common/driver.h"
+#include "common/openmp.h"
 #include "common/output.h"
 #include "common/summary.h"
 #include "descent.h"
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
     if (lab.convergence && lab.stability) throw cl::InputError("--stability: not with --convergence");
     if (lab.convergence || lab.stability) cl::refuse_run_flags(options, "only for a run of steps", "");
     lab.settings.init = cl::lab12::init_from_name(lab.init);
-    omp_set_num_threads(lab.threads);
+    cl::set_openmp_threads(lab.threads);
     if (live.on && (lab.convergence || lab.stability)) throw cl::InputError("--live: not with --convergence or --stability");
     if (live.on) return cl::lab12::run_live_scene(kLab, CL_LAB_SCENE_DIR, options, lab, live);
     if (lab.stability) return run_stability(options, lab);

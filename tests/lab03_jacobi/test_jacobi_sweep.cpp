@@ -1,6 +1,5 @@
 // Graded tests for lab03.1, jacobi_sweep. Analytic cases first, then
 // invariants: order independence, thread independence, pins, momentum.
-#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include "tests/support/catch.h"
 
 #include "common/metrics.h"
+#include "common/openmp.h"
 #include "common/scene.h"
 #include "gauss_seidel.h"
 #include "jacobi.h"
@@ -121,22 +121,22 @@ TEST_CASE("any permutation of the springs gives the same sweep to round-off", "[
 
 TEST_CASE("one and two threads give identical bits", "[lab03][pts=2]") {
   const cl::Scene scene = jittered_cloth(48, R"(["top-left", "top-right"])", 8);
-  const int saved = omp_get_max_threads();
+  const int saved = cl::openmp_max_threads();
   for (const auto& [omega, averaging] : {std::pair{1.0, Averaging::kByCount}, std::pair{1.3, Averaging::kNone}}) {
     CAPTURE(omega, averaging == Averaging::kByCount);
-    omp_set_num_threads(1);
+    cl::set_openmp_threads(1);
     Matrix3Xd serial = scene.particles.x;
     sweeps(4, serial, scene.particles.inv_mass, scene.springs, omega, averaging);
     for (const int threads : {2, 3, 4}) {
       CAPTURE(threads);
-      omp_set_num_threads(threads);
+      cl::set_openmp_threads(threads);
       Matrix3Xd parallel = scene.particles.x;
       sweeps(4, parallel, scene.particles.inv_mass, scene.springs, omega, averaging);
       REQUIRE(cl::test::at_least("the largest move of a particle over 4 sweeps", (parallel - scene.particles.x).colwise().norm().maxCoeff(), 1e-9));
       REQUIRE(cl::test::near(parallel, serial, 0.0, "particle"));
     }
   }
-  omp_set_num_threads(saved);
+  cl::set_openmp_threads(saved);
 }
 
 TEST_CASE("pinned particles never move", "[lab03][pts=1]") {
@@ -238,10 +238,16 @@ TEST_CASE("x_next is resized and bad shapes or bad omega throw std::invalid_argu
   Anchored scene(0.1);
   const cl::lab03::Incidence incidence = build_incidence(3, scene.springs);
   SECTION("x_next is resized") {
-    Matrix3Xd x_next;
-    jacobi_sweep(scene.x, x_next, scene.inv_mass, scene.springs, incidence, 1.0, Averaging::kByCount);
-    REQUIRE(x_next.cols() == 3);
-    REQUIRE(cl::test::near(x_next(0, 1), 1.0, 1e-15, "x of the free particle"));
+    // Empty, too many columns, too few: a driver may hand in any buffer.
+    for (const Eigen::Index columns : {0, 7, 1}) {
+      CAPTURE(columns);
+      Matrix3Xd x_next = Matrix3Xd::Constant(3, columns, 42.0);
+      jacobi_sweep(scene.x, x_next, scene.inv_mass, scene.springs, incidence, 1.0, Averaging::kByCount);
+      REQUIRE(cl::test::near(static_cast<double>(x_next.cols()), 3.0, 0.0, "columns of x_next"));
+      Matrix3Xd expected = scene.x;
+      expected(0, 1) = 1.0;  // the free particle, back at rest; the anchors unchanged
+      REQUIRE(cl::test::near(x_next, expected, 1e-15, "particle"));
+    }
   }
   SECTION("throws") {
     Matrix3Xd x_next;
@@ -260,5 +266,14 @@ TEST_CASE("x_next is resized and bad shapes or bad omega throw std::invalid_argu
     REQUIRE_THROWS_AS(jacobi_sweep(scene.x, x_next, VectorXd{{0.0, -1.0, 0.0}}, scene.springs, incidence, 1.0,
                                    Averaging::kByCount),
                       std::invalid_argument);
+    // A bad rest length is refused before the parallel loop too: thrown inside
+    // it, project_distance's exception would end the process instead.
+    for (const double rest_length : {-0.5, std::nan(""), HUGE_VAL}) {
+      CAPTURE(rest_length);
+      std::vector<Spring> springs = scene.springs;
+      springs[1].rest_length = rest_length;
+      REQUIRE_THROWS_AS(jacobi_sweep(scene.x, x_next, scene.inv_mass, springs, incidence, 1.0, Averaging::kByCount),
+                        std::invalid_argument);
+    }
   }
 }

@@ -245,6 +245,22 @@ TEST_CASE("solve and prolongation reject bad arguments with invalid_argument", "
   }
   Matrix3Xd too_few = start.leftCols(start.cols() - 1);
   REQUIRE_THROWS_AS(cl::lab10::solve_hierarchy(too_few, hierarchy, {1, 1, 1}), std::invalid_argument);
+  // Every level's inverse masses have one entry per particle, the coarse
+  // levels' too: one entry short or one too many is refused before x changes.
+  const Eigen::Index n = start.cols();
+  for (std::size_t l = 1; l < hierarchy.levels.size(); ++l) {
+    for (const Eigen::Index size : {n - 1, n + 1}) {
+      CAPTURE(l, size, n);
+      cl::ClothHierarchy resized = hierarchy;
+      Eigen::VectorXd& inv_mass = resized.levels[l].inv_mass;
+      const Eigen::VectorXd kept = inv_mass;
+      inv_mass = Eigen::VectorXd::Ones(size);
+      inv_mass.head(std::min(size, n)) = kept.head(std::min(size, n));
+      Matrix3Xd x = start;
+      REQUIRE_THROWS_AS(cl::lab10::solve_hierarchy(x, resized, {1, 1, 1}), std::invalid_argument);
+      REQUIRE(x == start);  // nothing changed before the throw
+    }
+  }
 
   const cl::HierarchyLevel& fine = hierarchy.levels[0];
   Matrix3Xd x = start;

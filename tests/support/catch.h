@@ -20,7 +20,21 @@
 #include <catch2/matchers/catch_matchers_string.hpp>
 using Catch::Approx;
 #else
-#include "tests/support/catch.h"
+#include <catch2/catch.hpp>
+#endif
+
+// Ends the running case as skipped, saying why: Catch2 3.3's SKIP; where there
+// is none (2.13, 3.0-3.2), a warning, and the case ends without a failure. The
+// grader skips such cases itself where it knows they cannot run (tools/cl/grade.py:
+// the cases tagged [openmp] in a build without OpenMP).
+#ifdef SKIP
+#define CL_SKIP(why) SKIP(why)
+#else
+#define CL_SKIP(why) \
+  do {               \
+    WARN(why);       \
+    return;          \
+  } while (false)
 #endif
 
 namespace cl::test {
@@ -30,7 +44,7 @@ inline auto ContainsText(const std::string& text) {
 #if CL_CATCH2_MAJOR >= 3
   return Catch::Matchers::ContainsSubstring(text);
 #else
-  return cl::test::ContainsText(text);
+  return Catch::Matchers::Contains(text);
 #endif
 }
 

@@ -1,6 +1,7 @@
 """./course test: everything CI checks, in the order it runs them."""
 import argparse
 import os
+import platform
 import re
 import shlex
 import shutil
@@ -90,6 +91,23 @@ class Checks:
         counted = sum(seconds for _, seconds, _, concurrent in self.times if not concurrent)
         print(f"  {rest:<{width}}  {total - counted:7.1f} s  {'':>9}  "
               f"{100 * (total - counted) / total:5.1f} %")
+        self.write_times(total, cpu_total, rest, total - counted)
+
+    def write_times(self, total, cpu_total, rest, rest_seconds):
+        """The same table as Markdown in BUILD/test-times.md, with the date, the
+        machine and the result: docs/testing.md quotes that file, never a hand copy."""
+        model = next((line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text(
+            encoding="utf-8", errors="replace").splitlines() if line.startswith("model name")),
+            platform.processor()) if Path("/proc/cpuinfo").is_file() else platform.processor()
+        machine = f"{model or platform.machine()}, {os.cpu_count()} cores, {platform.platform(terse=True)}"
+        lines = [f"{time.strftime('%Y-%m-%d')}, {machine}: {total:.0f} s in all, {cpu_total:.0f} s of CPU, "
+                 f"{self.passed} passed, {self.failed} failed (load at the end {os.getloadavg()[0]:.2f}).", "",
+                 "| step | wall s | CPU s |", "|---|---|---|"]
+        for step, seconds, cpu, concurrent in self.times:
+            used = "-" if cpu is None else f"{cpu:.0f}"
+            lines.append(f"| {step.strip()}{' (alongside)' if concurrent else ''} | {seconds:.0f} | {used} |")
+        lines.append(f"| {rest} | {rest_seconds:.0f} | |")
+        (BUILD / "test-times.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
 
     def finish(self):
         """Print the timing table and `N passed, M failed`; return the exit code."""

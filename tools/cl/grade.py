@@ -44,6 +44,7 @@ class CaseResult:
     # A failed expression in parts, for a terminal line that keeps what matters
     # when it must be cut: the source text, Catch2's expansion, file:line.
     parts: tuple = ()
+    skipped: str = ""  # why the case did not run here (it then neither scores nor counts)
 
     @property
     def score(self):
@@ -64,7 +65,7 @@ class LabResult:
 
     @property
     def max_score(self):
-        return sum(case.points for case in self.cases)
+        return sum(case.points for case in self.cases if not case.skipped)
 
     @property
     def passed(self):
@@ -72,7 +73,11 @@ class LabResult:
 
     @property
     def failed(self):
-        return [case for case in self.cases if not case.passed]
+        return [case for case in self.cases if not case.passed and not case.skipped]
+
+    @property
+    def skipped(self):
+        return [case for case in self.cases if case.skipped]
 
 
 def lab_id(lab):
@@ -119,10 +124,12 @@ def source_points(test_dir, tag):
     return int(total) if total.is_integer() else total
 
 
-def grade_lab(lab, binary, root, select=None, hidden=False):
+def grade_lab(lab, binary, root, select=None, hidden=False, skip_tags=None):
     """Run every case of `binary` tagged with the lab's tag (and accepted by
     `select`, a predicate on names; the [hidden] ones only when `hidden`);
-    return a LabResult."""
+    return a LabResult. `skip_tags` maps a tag to why its cases cannot run in
+    this build ({"[openmp]": "..."} without OpenMP): they are reported as
+    skipped, never run, never failed."""
     result = LabResult(lab)
     if not binary.is_file():
         result.errors.append(f"{relative(binary, root)} not found (is {lab} added in CMakeLists.txt?)")
@@ -134,6 +141,9 @@ def grade_lab(lab, binary, root, select=None, hidden=False):
         if not hidden:
             skipped = set(list_names(binary, tag + HIDDEN_TAG))
             names = [name for name in names if name not in skipped]
+        cannot_run = {}
+        for skip_tag, why in (skip_tags or {}).items():
+            cannot_run.update((name, why) for name in list_names(binary, tag + skip_tag))
     except ListingError as error:
         result.errors.append(f"{relative(binary, root)}: {error}")
         return result
@@ -148,9 +158,28 @@ def grade_lab(lab, binary, root, select=None, hidden=False):
                 result.errors.append(
                     f'{tag} test case "{name}" cannot be selected by name in Catch2 '
                     f"(because of '{unselectable.group()}'); rename the TEST_CASE")
+            elif name in cannot_run:
+                result.cases.append(CaseResult(name, points.get(name, 0), False, skipped=cannot_run[name]))
             elif name in points:
                 result.cases.append(run_case(binary, name, points[name], Path(work), root))
     return result
+
+
+NAMES_ONLY = {}  # binary -> the arguments that list names alone
+
+
+def names_only_listing(binary):
+    """Catch2 2.x lists names alone with --list-test-names-only; 3.x has no such
+    option (an error, exit 255) and lists them with --list-tests --verbosity quiet."""
+    if binary not in NAMES_ONLY:
+        try:
+            probe = subprocess.run([str(binary), "--list-test-names-only", "[no such tag]"], capture_output=True,
+                                   encoding="utf-8", errors="replace", timeout=LIST_TIMEOUT, check=False)
+            old = "Unrecognised token" not in probe.stdout + probe.stderr
+        except (OSError, subprocess.TimeoutExpired):
+            old = True  # catch_list reports the problem
+        NAMES_ONLY[binary] = ["--list-test-names-only"] if old else ["--list-tests", "--verbosity", "quiet"]
+    return NAMES_ONLY[binary]
 
 
 def catch_list(binary, *args):
@@ -169,7 +198,7 @@ def catch_list(binary, *args):
 
 def list_names(binary, spec):
     """Names of the test cases matching `spec`, in declaration order."""
-    names = catch_list(binary, "--list-test-names-only", spec)
+    names = catch_list(binary, *names_only_listing(binary), spec)
     # Catch2 quotes names that start with '#' in this listing.
     return [n[1:-1] if n.startswith('"#') and n.endswith('"') else n for n in names]
 
@@ -215,6 +244,10 @@ def run_case(binary, name, points, work, root):
     if test_case is None:
         return CaseResult(name, points, False, f"exit code {done.returncode} with no result")
     outcome = test_case.find("OverallResult")
+    if outcome is not None and outcome.get("skips", "0") != "0":  # Catch2 3's SKIP (exit code 4)
+        skip = test_case.find(".//Skip")
+        why = " ".join((skip.text or "").split()) if skip is not None else "skipped by the test"
+        return CaseResult(name, points, False, skipped=why)
     if outcome is not None and outcome.get("success") == "true":
         if done.returncode == 0:
             return CaseResult(name, points, True)
@@ -324,6 +357,8 @@ def case_output(case):
     """The text a student sees for one case in Gradescope."""
     if case.passed:
         return "passed"
+    if case.skipped:
+        return f"skipped: {case.skipped}"
     lines = [case.reason, *(f"with {info}" for info in case.details)]
     return clip("\n".join(lines), JSON_CAP, "cut by the grader")
 
@@ -332,7 +367,7 @@ def write_gradescope(path, labs):
     """Write Gradescope's results.json for a list of LabResult."""
     tests = [{"name": f"{lab_id(lab.lab)}: {case.name}",
               "score": case.score,
-              "max_score": case.points,
+              "max_score": 0 if case.skipped else case.points,
               "output": case_output(case),
               "visibility": "visible"}
              for lab in labs for case in lab.cases]

@@ -6,7 +6,7 @@ import sys
 from . import grade
 from .base import BIN, BUILD, ROOT, CourseError, show, under_root
 from .build import WARNING_LINES, BuildFailure, build_targets, configure, sanitizer_rerun, student_warnings
-from .labs import lab_dirs, lab_targets, manifest, resolve_lab
+from .labs import build_features, lab_dirs, lab_targets, manifest, resolve_lab
 
 
 class Grader:
@@ -49,7 +49,7 @@ class Grader:
         if not self.solutions:
             result.warnings = student_warnings(lab, output)
         suffix = "_tests_solution" if self.solutions else "_tests"
-        graded = grade.grade_lab(lab, BIN / (lab + suffix), ROOT, select, hidden=self.hidden)
+        graded = grade.grade_lab(lab, BIN / (lab + suffix), ROOT, select, hidden=self.hidden, skip_tags=skip_tags())
         result.cases, result.errors = graded.cases, result.errors + graded.errors
         if self.sanitize and not self.solutions:
             for case in [c for c in result.cases if c.signal][:2]:
@@ -115,6 +115,14 @@ def number_of(lab):
     return grade.lab_id(lab)[3:]
 
 
+def skip_tags():
+    """The graded cases this build cannot run, by tag, and why (grade.grade_lab)."""
+    if build_features().get("openmp", True):
+        return {}
+    return {"[openmp]": "this build has no OpenMP, so there is no parallel region to count "
+                        "(macOS: brew install libomp, then remove build/ and grade again)"}
+
+
 def print_grades(results, notes, verbose=False):
     """Per-lab table; failed cases with the reason and their context; build
     errors, warnings, notes on earlier labs; `Score: X/Y`."""
@@ -124,7 +132,7 @@ def print_grades(results, notes, verbose=False):
         if r.build_errors:
             rows.append([r.lab, "-", f"0/{fmt(r.max_known)}  does not compile"])
         else:
-            rows.append([r.lab, f"{len(r.passed)}/{len(r.cases)}", f"{fmt(r.score)}/{fmt(r.max_score)}"])
+            rows.append([r.lab, f"{len(r.passed)}/{len(r.cases) - len(r.skipped)}", f"{fmt(r.score)}/{fmt(r.max_score)}"])
     widths = [max(len(row[i]) for row in rows) for i in range(2)]
     print()
     for row in rows:
@@ -139,6 +147,9 @@ def print_grades(results, notes, verbose=False):
             if case.passed:
                 if verbose:
                     print(f'  pass {tag} "{case.name}" ({fmt(case.points)} pts)')
+                continue
+            if case.skipped:
+                print(f'  SKIP {tag} "{case.name}" ({fmt(case.points)} pts, not counted): {case.skipped}')
                 continue
             print(f'  FAIL {tag} "{case.name}" ({fmt(case.points)} pts)')
             print(f"       {grade.terminal_reason(case)}")

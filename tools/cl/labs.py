@@ -23,6 +23,15 @@ def manifest():
         return {}
 
 
+def build_features():
+    """build/labs.json's "build": what the configured build has that grading
+    depends on ({"openmp": bool, "catch2": major version})."""
+    try:
+        return json.loads(MANIFEST.read_text(encoding="utf-8")).get("build", {})
+    except (OSError, ValueError):
+        return {}
+
+
 def manifest_stale():
     """True when a lab or a reference appeared or went since the last configure."""
     labs = manifest()

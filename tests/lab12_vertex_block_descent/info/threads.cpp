@@ -11,7 +11,6 @@
 // than that (each colour ends at a barrier that waits for a descheduled
 // thread), so the line is information, never a grade.
 // Exit 0 with that line; 3 when a function it needs is not written yet.
-#include <omp.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "common/not_implemented.h"
+#include "common/openmp.h"
 #include "common/scene.h"
 #include "common/timer.h"
 #include "descent.h"
@@ -36,7 +36,7 @@ struct Setup {
 // The fastest of `repeats` sweeps from the prediction on `threads` threads:
 // the least disturbed by the other processes on a shared machine.
 double best_sweep_seconds(const Setup& setup, int threads, int repeats) {
-  omp_set_num_threads(threads);
+  cl::set_openmp_threads(threads);
   double best = 1e300;
   for (int r = 0; r < repeats; ++r) {
     Eigen::Matrix3Xd x = setup.y;
