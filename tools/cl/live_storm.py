@@ -24,7 +24,7 @@ import statistics
 import subprocess
 import time
 
-from .live_stress import frame, open_socket, rss
+from .live_stress import open_socket, rss
 
 TINY_SOCKETS = 15
 TINY_SECONDS = 3.0
