@@ -133,12 +133,12 @@ class StepThread {
 }  // namespace
 
 std::string live_page() {
-  const std::string three = "/usr/share/javascript/three/";
-  const char* hint = "install Debian's libjs-three: ./course installs it";
+  const std::string three = std::string(source_dir()) + "/tools/cl/vendor/three/";  // npm's three@0.111.0
+  const char* hint = "the course's tree";
   std::string page = read_text(std::string(source_dir()) + "/tools/cl/live_page.html", "the course's tree");
   replace_once(page, "<!--three-->",
                "<script>\n" + read_text(three + "three.min.js", hint) + "\n</script>\n<script>\n" +
-                   read_text(three + "examples/js/controls/OrbitControls.js", hint) + "\n</script>");
+                   read_text(three + "OrbitControls.js", hint) + "\n</script>");
   replace_once(page, "<!--player-->",
                "<script>\n" + read_text(std::string(source_dir()) + "/tools/cl/view_player.js", "the course's tree") +
                    "\n</script>");

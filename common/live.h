@@ -85,7 +85,7 @@ struct LiveRun {
 // InputError when the page's files are missing or the port cannot be had.
 int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const std::string& summary_path);
 
-// The page: tools/cl/live_page.html with Debian's three.js, its
+// The page: tools/cl/live_page.html with three.js (tools/cl/vendor/three/), its
 // OrbitControls and tools/cl/view_player.js inlined. Throws InputError naming
 // a missing file.
 std::string live_page();

@@ -47,7 +47,7 @@ def run(main):
 
 def rows(path, ok_only=False):
     """A CSV file's rows as dicts of text; with ok_only those whose status is "ok"."""
-    with open(path, newline="") as handle:
+    with open(path, newline="", encoding="utf-8") as handle:
         found = list(csv.DictReader(handle))
     return [r for r in found if r["status"] == "ok"] if ok_only else found
 
@@ -75,7 +75,7 @@ def number(text):
 def summary(path):
     """A run's JSON summary, or {} when there is none."""
     path = Path(path)
-    return json.loads(path.read_text()) if path.exists() else {}
+    return json.loads(path.read_text(encoding="utf-8")) if path.exists() else {}
 
 
 # ---------------------------------------------------------------- skip, up to date, save
@@ -119,7 +119,7 @@ def save(figure, target, dpi=110):
 
 def write_table(target, text):
     """Write a Markdown table beside a figure, say so."""
-    Path(target).write_text(text)
+    Path(target).write_text(text, encoding="utf-8")
     print(f"wrote {target}")
 
 

@@ -16,7 +16,7 @@ class Frame:
         self.path = Path(path)
         self.scene, self.frame, self.time = "?", 0, 0.0
         vertices, faces, lines = [], [], []
-        with open(path) as handle:
+        with open(path, encoding="utf-8") as handle:
             for line in handle:
                 if line.startswith("v "):
                     vertices.append([float(value) for value in line.split()[1:4]])

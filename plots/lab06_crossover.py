@@ -70,7 +70,7 @@ def table(rows, path):
                 else:
                     cells["newton"] = f"{row['iterations']}, {float(row['seconds']):.3g}"
         lines.append(f"| {scene} | {unknowns} | {target:g} | {cells.get('pd', '-')} | {cells.get('newton', '-')} |")
-    path.write_text("\n".join(lines) + "\n")
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
 def main(out_dir):

@@ -1,10 +1,14 @@
 """Constraint Labs driver: build, demo, test, grade, run, plots, bench.
 
-Started by ../course, which installs the Debian packages and picks a Python
-with matplotlib. The commands live in the package tools/cl/, one module per
+Started by ../course (or ../course.cmd on Windows), which picks a Python.
+Before a command runs, what it needs is checked by what the system can do
+(tools/cl/requirements.py: installed with apt on Debian as root, else one line
+saying how). The commands live in the package tools/cl/, one module per
 concern (docs/DESIGN.md §1); this file only dispatches. Paths are relative to
 the course root, not the cwd.
 """
+import argparse
+import os
 import sys
 
 from cl.autograder import cmd_autograder
@@ -20,6 +24,7 @@ from cl.measure import cmd_bench, cmd_extremes
 from cl.mistakes import cmd_mistakes
 from cl.plots import cmd_plots
 from cl.release import cmd_release
+from cl.requirements import ensure
 from cl.sanitize import cmd_sanitize
 from cl.view import cmd_view
 
@@ -57,16 +62,38 @@ usage: ./course COMMAND [ARGS]
                                      each planted: the grader must catch it (instructor)
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
   sanitize                           the whole test suite under AddressSanitizer and UBSan (build-asan)
+  setup [--all]                      install what the student's commands need (Debian and Ubuntu
+                                     as root), or print the one line that does; --all: the
+                                     instructor's too (what ./course test needs)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
+def cmd_setup(argv):
+    """./course setup [--all]: what the commands need, installed or told, at once
+    rather than at a command's first run (the dev container's image runs it)."""
+    parser = argparse.ArgumentParser(prog="course setup", description="install what the course needs")
+    parser.add_argument("--all", action="store_true", help="the instructor's too (what ./course test needs)")
+    args = parser.parse_args(argv)
+    code, missing = ensure("test" if args.all else "demo")
+    if missing:
+        print(missing, file=sys.stderr)
+    else:
+        who = "every command needs" if args.all else "the student's commands need"
+        print(f"course setup: what {who} is installed")
+    return code
+
+
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
+            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live,
+            "setup": cmd_setup}
 
 
 def main(argv):
+    if os.name == "nt":  # a redirected stdout is the locale's (cp1252) there: the course prints UTF-8 (−, ², ≥)
+        for stream in (sys.stdout, sys.stderr):
+            stream.reconfigure(encoding="utf-8", errors="replace")
     if not argv or argv[0] in ("help", "-h", "--help"):
         print(USAGE)
         return 0
@@ -74,6 +101,11 @@ def main(argv):
     if command is None:
         print(f"course: unknown command '{argv[0]}' (try ./course help)", file=sys.stderr)
         return 2
+    code, missing = ensure(argv[0])
+    if missing:
+        print(missing, file=sys.stderr)
+    if code:
+        return code
     try:
         return command(argv[1:])
     except CourseError as error:

@@ -2,7 +2,7 @@
 the CI check that builds one and grades four submissions with it.
 
 The bundle is a zip with, at its top (Gradescope unpacks it into /autograder/source):
-  setup.sh          run once as root: installs the Debian packages of ./course and
+  setup.sh          run once as root: installs what ./course grade needs (apt) and
                     builds the lab's graded tests against the stubs (tools/gradescope/)
   run_autograder    run per submission: the student's files in, rebuild, grade,
                     /autograder/results/results.json (always valid JSON)
@@ -58,7 +58,8 @@ def points_in_sources(lab):
     read from tests/LAB/*.cpp: known before anything is built."""
     tag, visible, hidden, count = grade.lab_tag(lab).lower(), 0.0, 0.0, 0
     for source in sorted((ROOT / "tests" / lab).glob("*.cpp")):
-        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', source.read_text()):
+        text = source.read_text(encoding="utf-8")
+        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', text):
             if tag not in tags.lower():
                 continue
             points = sum(float(p) for p in grade.PTS_TAG.findall(tags) if re.fullmatch(r"[0-9.]+", p))
@@ -80,7 +81,7 @@ def write_bundle(lab, zip_path, case_timeout=CASE_TIMEOUT, run_limit=RUN_LIMIT):
         for name in TEMPLATE_FILES:
             shutil.copy2(TEMPLATES / name, stage / name)
         config = {"lab": lab, "files": students, "case_timeout": case_timeout, "run_limit": run_limit}
-        (stage / "autograder.json").write_text(json.dumps(config, indent=2) + "\n")
+        (stage / "autograder.json").write_text(json.dumps(config, indent=2) + "\n", encoding="utf-8")
         zip_path.parent.mkdir(parents=True, exist_ok=True)
         partial = zip_path.with_name(zip_path.name + ".partial")
         with zipfile.ZipFile(partial, "w", zipfile.ZIP_DEFLATED) as bundle:
@@ -133,7 +134,7 @@ def unpack(zip_path, dest):
 def results_of(path):
     """(results.json as a dict, or None, and the problem)."""
     try:
-        data = json.loads(path.read_text())
+        data = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as error:
         return None, f"results.json is not valid JSON: {error}"
     if not isinstance(data.get("tests"), list) or "score" not in data:
@@ -150,8 +151,8 @@ def check_autograder(checks, lab_token="lab02"):
     lab = ids.get(lab_token)
     if lab is None:
         return
-    reference = (ROOT / "solutions" / lab / "gauss_seidel.cpp").read_text()
-    stub = (ROOT / "labs" / lab / "gauss_seidel.cpp").read_text()
+    reference = (ROOT / "solutions" / lab / "gauss_seidel.cpp").read_text(encoding="utf-8")
+    stub = (ROOT / "labs" / lab / "gauss_seidel.cpp").read_text(encoding="utf-8")
     signature = "const std::vector<Spring>& springs, const std::vector<int>& order) {\n"
     endless = reference.replace(signature, signature + "  for (volatile long spin = 0;; spin = spin + 1) {\n  }\n", 1)
     if endless == reference:
@@ -179,7 +180,7 @@ def check_autograder(checks, lab_token="lab02"):
         env.pop("CL_BUILD_DIR", None)
         began = time.monotonic()
         done = subprocess.run(["bash", str(source / "setup.sh")], cwd=source, env=env, capture_output=True,
-                              text=True, check=False)
+                              encoding="utf-8", errors="replace", check=False)
         lines = (done.stdout + done.stderr).splitlines()
         checks.record(done.returncode == 0, f"autograder {lab_token}: setup.sh "
                       f"({time.monotonic() - began:.0f} s): {lines[-1] if lines else 'no output'}",
@@ -194,13 +195,13 @@ def check_autograder(checks, lab_token="lab02"):
             submission.mkdir(parents=True)
             for name, text in files.items():
                 (submission / name).parent.mkdir(parents=True, exist_ok=True)
-                (submission / name).write_text(text)
+                (submission / name).write_text(text, encoding="utf-8")
             results = root / "results" / "results.json"
             results.unlink(missing_ok=True)
             began = time.monotonic()
             run_env = dict(env, **{f"AUTOGRADER_{k.upper()}": str(v) for k, v in limits.items()})
             done = subprocess.run([str(root / "run_autograder")], cwd=root, env=run_env, capture_output=True,
-                                  text=True, check=False)
+                                  encoding="utf-8", errors="replace", check=False)
             data, problem = results_of(results)
             took = time.monotonic() - began
             if data is None:

@@ -13,8 +13,9 @@ import tempfile
 import time
 
 from . import grade
-from .base import BIN, BUILD, ROOT, CourseError
+from .base import BUILD, CONFIG, ROOT, CourseError, program
 from .labs import manifest, manifest_stale
+from .requirements import cmake_hints
 
 ERROR_LINES = 14  # of a failed build, shown
 WARNING_LINES = 3  # of the warnings in a student's files, shown
@@ -42,7 +43,7 @@ def generator_args(build_dir):
 
 def uses_ninja(build_dir):
     cache = build_dir / "CMakeCache.txt"
-    return cache.is_file() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" in cache.read_text()
+    return cache.is_file() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" in cache.read_text(encoding="utf-8")
 
 
 def configure(log=sys.stdout, force=False):
@@ -51,8 +52,8 @@ def configure(log=sys.stdout, force=False):
         print("configuring...", end=" ", file=log, flush=True)
         start = time.monotonic()
         try:
-            quiet(["cmake", "-S", str(ROOT), "-B", str(BUILD), *generator_args(BUILD), "-DCMAKE_BUILD_TYPE=Release"],
-                  "configure")
+            quiet(["cmake", "-S", str(ROOT), "-B", str(BUILD), *generator_args(BUILD), "-DCMAKE_BUILD_TYPE=Release",
+                   *cmake_hints()], "configure")
         finally:
             print(f"{time.monotonic() - start:.1f} s", file=log, flush=True)
 
@@ -71,7 +72,7 @@ def build(log=sys.stdout):
 def quiet(command, what):
     try:
         done = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE,
-                              stderr=subprocess.STDOUT, text=True, check=False)
+                              stderr=subprocess.STDOUT, encoding="utf-8", errors="replace", check=False)
     except FileNotFoundError:
         raise CourseError(f"{command[0]} not found; ./course installs it") from None
     if done.returncode != 0:
@@ -81,7 +82,7 @@ def quiet(command, what):
 
 def build_command(targets, build_dir, keep_going=False):
     """The command that builds `targets` in build_dir on both cores (keep_going: past a failure)."""
-    command = ["cmake", "--build", str(build_dir), "-j", "2", "--target", *targets]
+    command = ["cmake", "--build", str(build_dir), "--config", CONFIG, "-j", "2", "--target", *targets]
     if keep_going:
         command += ["--", "-k", "0"] if uses_ninja(build_dir) else ["--", "-k"]
     return command
@@ -96,7 +97,8 @@ def build_targets(targets, build_dir=None, log=sys.stdout, label=None, keep_goin
     start = time.monotonic()
     try:
         done = subprocess.run(build_command(targets, build_dir, keep_going),
-                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                              cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                              encoding="utf-8", errors="replace",
                               check=False)
     except FileNotFoundError:
         raise CourseError("cmake not found; ./course installs it") from None
@@ -130,7 +132,14 @@ def first_errors(output):
             start -= 1
         shown = lines[start:start + ERROR_LINES]
     # A path relative to the build folder (ccache's base_dir in ./course test) reads from the root too.
-    return [re.sub(r"(^|[\s(])\.\./(?=\w)", r"\1", line.replace(str(ROOT) + "/", "")) for line in shown]
+    return [re.sub(r"(^|[\s(])\.\./(?=\w)", r"\1", from_root(line)) for line in shown]
+
+
+def from_root(line):
+    """A compiler's line with the tree's paths relative to it (MinGW's say C:/..., or C:\\...)."""
+    for prefix in {ROOT.as_posix() + "/", str(ROOT) + os.sep}:
+        line = line.replace(prefix, "")
+    return line
 
 
 def student_warnings(lab, output):
@@ -142,12 +151,11 @@ def student_warnings(lab, output):
     for student in manifest().get(lab, {}).get("student", []):
         remembered = cache / (student.replace("/", "__") + ".txt")
         if f"CMakeFiles/{lab}_student.dir/{student}.o" in output:
-            path = str(ROOT / student)
-            lines = [line.replace(str(ROOT) + "/", "") for line in output.splitlines()
-                     if line.startswith(path + ":") and ": warning:" in line]
-            remembered.write_text("".join(line + "\n" for line in lines))
+            lines = [from_root(line) for line in output.splitlines()
+                     if from_root(line).startswith(student + ":") and ": warning:" in line]
+            remembered.write_text("".join(line + "\n" for line in lines), encoding="utf-8")
         if remembered.is_file():
-            found += remembered.read_text().splitlines()
+            found += remembered.read_text(encoding="utf-8").splitlines()
     return found
 
 
@@ -169,13 +177,13 @@ def sanitizer_rerun(lab, case, log=sys.stdout):
         build_targets([target], log=log, label=f"{target} (-fsanitize=address,undefined)")
     except BuildFailure as failure:
         return ["the sanitizer build failed:", *failure.lines[:4]]
-    binary = BIN / target
+    binary = program(target)
     # A crash is what is asked about here, so leaks are not reported.
     env = sanitizer_env(leaks=False)
     with tempfile.TemporaryDirectory(prefix="cl-asan-") as work:
         try:
             done = subprocess.run([str(binary), case.name], cwd=work, env=env, capture_output=True,
-                                  text=True, timeout=grade.CASE_TIMEOUT, check=False)
+                                  encoding="utf-8", errors="replace", timeout=grade.CASE_TIMEOUT, check=False)
         except subprocess.TimeoutExpired:
             return ["the sanitizer run timed out"]
     lines = grade.sanitizer_report(done.stdout + done.stderr, ROOT)

@@ -14,7 +14,8 @@ from pathlib import Path
 
 from . import grade
 from .autograder import check_autograder
-from .base import BIN, BUILD, ROOT, CourseError, show
+from .base import BUILD, ROOT, CourseError, show
+from .base import program as program_path
 from .build import BuildFailure, build_targets, configure
 from .claims import run_claims
 from .demo import index_links, run_demos, write_index, write_views
@@ -26,6 +27,7 @@ from .live_checks import check_live
 from .measure import check_measurements
 from .mistakes import catalogue, run_mistakes
 from .plots import run_plots
+from .portability import check_portability
 from .release import is_release
 from .sanitize import background_cpu, check_sanitize, start_sanitize
 from .student_loop import check_student_loop
@@ -197,7 +199,7 @@ def check_ctest(checks):
         return
     with checks.timed("unit tests (ctest -L unit)"):
         done = subprocess.run(["ctest", "--test-dir", str(BUILD), "-L", "unit", "--output-on-failure"],
-                              cwd=ROOT, capture_output=True, text=True, check=False)
+                              cwd=ROOT, capture_output=True, encoding="utf-8", errors="replace", check=False)
     ok = done.returncode == 0
     lines = [line for line in done.stdout.splitlines() if "tests passed" in line]
     details = [] if ok else (done.stdout + done.stderr).splitlines()
@@ -212,10 +214,9 @@ def unregistered_cases():
     catch_discover_tests splits a name at ';' and passes it to Catch as a test
     spec: the halves of such a case match no case, and Catch 2 passes a run
     that matched none, so the case would never run in ctest."""
-    listed = subprocess.run([str(BUILD / "bin" / "common_tests"), "--list-test-names-only"], cwd=ROOT,
-                            capture_output=True, text=True, check=False).stdout
+    listed = "\n".join(grade.list_names(program_path("common_tests")))
     known = subprocess.run(["ctest", "--test-dir", str(BUILD), "-N", "-L", "unit"], cwd=ROOT,
-                           capture_output=True, text=True, check=False).stdout
+                           capture_output=True, encoding="utf-8", errors="replace", check=False).stdout
     names = {match.group(1) for match in re.finditer(r"Test\s+#\d+: (.*)$", known, re.MULTILINE)}
     cases = [name.strip() for name in listed.splitlines() if name.strip()]
     return [name for name in cases if name not in names]
@@ -283,11 +284,12 @@ def refusal_problem(program, args, expected):
         argv = [arg.replace("{tmp}", str(scratch)) for arg in args]
         for i in range(1, len(argv)):
             if argv[i - 1] == "--scene" and argv[i].startswith("{"):
-                (scratch / "bad.json").write_text(argv[i])
+                (scratch / "bad.json").write_text(argv[i], encoding="utf-8")
                 argv[i] = str(scratch / "bad.json")
         before = sorted(scratch.rglob("*"))
         try:
-            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True, text=True,
+            done = subprocess.run([str(program), *argv], cwd=scratch, capture_output=True,
+                                  encoding="utf-8", errors="replace",
                                   timeout=60, check=False)
         except subprocess.TimeoutExpired:
             return "ran past 60 s instead of refusing"
@@ -316,7 +318,7 @@ def check_rejects(checks, labs):
         if not cases:
             continue
         name = lab + ("_solution" if entries[lab]["reference"] else "")
-        program = BIN / name
+        program = program_path(name)
         problems = []
         for args, expected in cases:
             problem = refusal_problem(program, args, expected)
@@ -390,7 +392,7 @@ def check_house_limits(checks):
     """Every file of HOUSE_LIMITS within its number of lines."""
     for pattern, limit in HOUSE_LIMITS:
         over = [f"{show(path)}: {count} lines" for path in sorted(ROOT.glob(pattern))
-                if (count := len(path.read_text().splitlines())) > limit]
+                if (count := len(path.read_text(encoding="utf-8").splitlines())) > limit]
         checks.record(not over, f"{pattern}: at most {limit} lines each", over)
 
 
@@ -412,6 +414,7 @@ def cmd_test(argv):
         checks.record(False, str(error), error.details)
         return checks.finish()
     check_house_limits(checks)
+    check_portability(checks)  # text I/O's encodings, the requirement messages: about a second
     # The sanitizer build compiles, then runs the suite, in the background,
     # niced, from the start: niced, it takes what the foreground leaves (the
     # main build's links and its last files, the checks that run one process

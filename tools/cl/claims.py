@@ -21,7 +21,8 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-from .base import BIN, ROOT, CourseError
+from .base import ROOT, CourseError
+from .base import program as executable_path
 from .build import BuildFailure, build_targets, configure
 from .labs import lab_dirs, manifest, resolve_lab
 
@@ -40,7 +41,7 @@ def load_claims(lab):
     if not path.is_file():
         return []
     try:
-        claims = json.loads(path.read_text())
+        claims = json.loads(path.read_text(encoding="utf-8"))
     except ValueError as error:
         raise CourseError(f"{path.relative_to(ROOT)}: not JSON ({error})", code=2) from None
     seen = set()
@@ -83,7 +84,8 @@ def run_command(command, solutions, scratch, timeout, bin_dir=None):
     name, args = program_of(command, solutions)
     start = time.monotonic()
     try:
-        done = subprocess.run([str((bin_dir or BIN) / name), *args], cwd=scratch, capture_output=True, text=True,
+        done = subprocess.run([str(executable_path(name, bin_dir)), *args], cwd=scratch, capture_output=True,
+                              encoding="utf-8", errors="replace",
                               timeout=timeout, check=False)
     except subprocess.TimeoutExpired:
         return f"(ran past {timeout} s)", -1, time.monotonic() - start
@@ -98,7 +100,7 @@ def read_value(read, output, scratch):
             raise LookupError(f"no line matches /{read['stdout']}/")
         return as_number(match.group(1))
     if "csv" in read:
-        with open(scratch / read["csv"], newline="") as handle:
+        with open(scratch / read["csv"], newline="", encoding="utf-8") as handle:
             rows = list(csv.DictReader(handle))
         wanted = read.get("row", {})
         found = [row for row in rows if all(same(row.get(key), value) for key, value in wanted.items())]
@@ -118,7 +120,7 @@ def read_value(read, output, scratch):
         return {"first": values[0], "last": values[-1], "max": max(values), "min": min(values)}[pick]
     for kind in ("summary", "json"):
         if kind in read:
-            value = json.loads((scratch / read[kind]).read_text())
+            value = json.loads((scratch / read[kind]).read_text(encoding="utf-8"))
             for key in str(read["key"]).split("."):
                 value = value[int(key)] if isinstance(value, list) else value[key]
             return as_number(value) if isinstance(value, str) else value
@@ -165,7 +167,7 @@ def tolerance_text(tolerance):
 def check_lab(lab, quick, solutions):
     """(held, total, failures) of one lab's claims: failures are lines to print."""
     claims = [c for c in load_claims(lab) if c.get("quick") or not quick]
-    page = squeeze((ROOT / "labs" / lab / "README.md").read_text())
+    page = squeeze((ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))
     failures = []
     commands = list(dict.fromkeys(c["command"] for c in claims))
     with tempfile.TemporaryDirectory(prefix="cl-claims-") as scratch:

@@ -12,7 +12,7 @@ from html.parser import HTMLParser
 from pathlib import Path
 
 from . import grade
-from .base import ROOT, CourseError, show, under_root
+from .base import ROOT, CourseError, become, show, under_root
 from .build import BuildFailure, build_targets, configure
 from .labs import demo_lines, executable, lab_dirs, manifest, resolve_lab, view_lines
 from .plots import plots_failed, run_plots
@@ -51,7 +51,7 @@ def run_demos(out, echo=True, labs=None, quick=False):
             if echo:
                 print("  " + shown, flush=True)
             argv = [str(program), *(arg.replace("{out}", str(lab_out)) for arg in args)]
-            done = subprocess.run(argv, cwd=ROOT, capture_output=True, text=True, check=False)
+            done = subprocess.run(argv, cwd=ROOT, capture_output=True, encoding="utf-8", errors="replace", check=False)
             if done.returncode != 0:
                 raise CourseError(f"{shown} exited with code {done.returncode}",
                                   details=done.stderr.splitlines())
@@ -123,7 +123,7 @@ coloured by strain. Make your own with <code>./course view DIR [DIR2]</code>.</p
 
 def write_index(out):
     path = out / "index.html"
-    path.write_text(index_page(out))
+    path.write_text(index_page(out), encoding="utf-8")
     return path
 
 
@@ -138,7 +138,7 @@ def index_links(out):
                     if not (out / value).is_file():
                         missing.append(value)
 
-    Links().feed((out / "index.html").read_text())
+    Links().feed((out / "index.html").read_text(encoding="utf-8"))
     return missing
 
 
@@ -147,7 +147,7 @@ def summaries(out):
     found = []
     for path in sorted(out.glob("lab[0-9][0-9]_*/*.json")):
         try:
-            data = json.loads(path.read_text())
+            data = json.loads(path.read_text(encoding="utf-8"))
         except (OSError, ValueError):
             continue
         if isinstance(data, dict) and "lab" in data and "seconds" in data:
@@ -214,5 +214,4 @@ def cmd_run(argv):
     except BuildFailure as failure:
         raise CourseError(f"{name} does not build", details=failure.lines) from None
     program = executable(name)
-    sys.stdout.flush()
-    os.execv(program, [str(program), *argv[1:]])
+    return become(program, [str(program), *argv[1:]])

@@ -26,7 +26,7 @@ def build_fuzzer(log=sys.stdout):
     (fuzz_live beside it)."""
     fuzz_build = BUILD / "fuzz"
     if shutil.which("clang++") is None:
-        raise CourseError("clang++ not found (apt-get install clang libclang-rt-14-dev)", code=2)
+        raise CourseError("clang++ not found (Debian and Ubuntu: apt-get install clang libclang-rt-dev)", code=2)
     if not (fuzz_build / "CMakeCache.txt").is_file():
         quiet(["cmake", "-S", str(ROOT / "fuzz"), "-B", str(fuzz_build), *generator_args(fuzz_build),
                "-DCMAKE_CXX_COMPILER=clang++",
@@ -52,7 +52,7 @@ def fuzz_one(program, seconds):
     done = subprocess.run([str(program), f"-max_total_time={seconds}", "-rss_limit_mb=2048",
                            "-max_len=4096" if program.name == "fuzz_scene" else "-max_len=5000",
                            f"-dict={dictionary}", f"-artifact_prefix={artifacts}/", str(corpus)],
-                          cwd=fuzz_build, capture_output=True, text=True, check=False)
+                          cwd=fuzz_build, capture_output=True, encoding="utf-8", errors="replace", check=False)
     lines = [line for line in done.stderr.splitlines() if line.strip()]
     kept = []
     for artifact in sorted(artifacts.iterdir()):

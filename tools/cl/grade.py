@@ -114,7 +114,8 @@ def source_points(test_dir, tag):
     lab can score, known even when its tests do not compile."""
     total = 0.0
     for source in sorted(Path(test_dir).glob("*.cpp")):
-        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', source.read_text()):
+        text = source.read_text(encoding="utf-8")
+        for tags in re.findall(r'TEST_CASE\s*\(\s*"(?:[^"\\]|\\.)*"\s*,\s*"([^"]*)"', text):
             if tag.lower() in tags.lower() and HIDDEN_TAG not in tags.lower():
                 for spelling in PTS_TAG.findall(tags):
                     try:
@@ -165,27 +166,11 @@ def grade_lab(lab, binary, root, select=None, hidden=False, skip_tags=None):
     return result
 
 
-NAMES_ONLY = {}  # binary -> the arguments that list names alone
-
-
-def names_only_listing(binary):
-    """Catch2 2.x lists names alone with --list-test-names-only; 3.x has no such
-    option (an error, exit 255) and lists them with --list-tests --verbosity quiet."""
-    if binary not in NAMES_ONLY:
-        try:
-            probe = subprocess.run([str(binary), "--list-test-names-only", "[no such tag]"], capture_output=True,
-                                   encoding="utf-8", errors="replace", timeout=LIST_TIMEOUT, check=False)
-            old = "Unrecognised token" not in probe.stdout + probe.stderr
-        except (OSError, subprocess.TimeoutExpired):
-            old = True  # catch_list reports the problem
-        NAMES_ONLY[binary] = ["--list-test-names-only"] if old else ["--list-tests", "--verbosity", "quiet"]
-    return NAMES_ONLY[binary]
-
-
-def catch_list(binary, *args):
-    """Output lines of a Catch2 listing (its exit code is a count, not a status)."""
+def catch_list(binary, *args, stderr=False):
+    """Output lines of a Catch2 listing (its exit code is a count, not a status);
+    stderr: its stderr's lines too."""
     try:
-        done = subprocess.run([str(binary), *args], capture_output=True, text=True,
+        done = subprocess.run([str(binary), *args], capture_output=True, encoding="utf-8", errors="replace",
                               timeout=LIST_TIMEOUT, check=False)
     except subprocess.TimeoutExpired:
         raise ListingError(f"listing timed out after {LIST_TIMEOUT} s") from None
@@ -193,12 +178,27 @@ def catch_list(binary, *args):
         raise ListingError(f"cannot run ({error.strerror})") from None
     if done.returncode < 0:
         raise ListingError(f"crashed (signal {-done.returncode}) while listing its tests")
-    return [line.strip() for line in done.stdout.splitlines() if line.strip()]
+    return [line.strip() for line in (done.stdout + (done.stderr if stderr else "")).splitlines() if line.strip()]
 
 
-def list_names(binary, spec):
-    """Names of the test cases matching `spec`, in declaration order."""
-    names = catch_list(binary, *names_only_listing(binary), spec)
+_NAMES_ONLY = {}  # binary -> the flags that list names only: Catch2 2.x's, or 3.x's
+
+
+def names_only_flags(binary):
+    """Catch2 2.x lists bare names with --list-test-names-only; 3.x dropped the
+    flag (Debian 13, Ubuntu 24.04, Homebrew, MSYS2 ship only 3.x) for
+    --list-tests at quiet verbosity."""
+    key = str(binary)
+    if key not in _NAMES_ONLY:
+        said = catch_list(binary, "--list-test-names-only", "[cl-probe-no-such-tag]", stderr=True)
+        v3 = any("Unrecognised token" in line and "--list-test-names-only" in line for line in said)
+        _NAMES_ONLY[key] = ["--list-tests", "--verbosity", "quiet"] if v3 else ["--list-test-names-only"]
+    return _NAMES_ONLY[key]
+
+
+def list_names(binary, spec=None):
+    """Names of the test cases matching `spec` (None: every case), in declaration order."""
+    names = catch_list(binary, *names_only_flags(binary), *([spec] if spec is not None else []))
     # Catch2 quotes names that start with '#' in this listing.
     return [n[1:-1] if n.startswith('"#') and n.endswith('"') else n for n in names]
 
@@ -232,7 +232,9 @@ def run_case(binary, name, points, work, root):
     report = work / "report.xml"
     report.unlink(missing_ok=True)
     try:
-        done = subprocess.run([str(binary), name, "-r", "xml", "-o", str(report)], cwd=work, env=CASE_ENV,
+        # -o relative to the cwd: an absolute one failed under Wine (a Windows
+        # program given a POSIX path); a relative one is the same on every system.
+        done = subprocess.run([str(binary), name, "-r", "xml", "-o", report.name], cwd=work, env=CASE_ENV,
                               capture_output=True, timeout=CASE_TIMEOUT, check=False)
     except subprocess.TimeoutExpired:
         return CaseResult(name, points, False, f"timed out after {CASE_TIMEOUT} s")
@@ -378,7 +380,7 @@ def write_gradescope(path, labs):
                "max_score": sum(lab.max_score for lab in labs),
                "tests": tests}
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(results, indent=2) + "\n")
+    path.write_text(json.dumps(results, indent=2) + "\n", encoding="utf-8")
 
 
 # ---------------------------------------------------------------- sanitizer reports

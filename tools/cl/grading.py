@@ -4,7 +4,8 @@ import subprocess
 import sys
 
 from . import grade
-from .base import BIN, BUILD, ROOT, CourseError, show, under_root
+from .base import BUILD, ROOT, CourseError, show, under_root
+from .base import program as executable_path
 from .build import WARNING_LINES, BuildFailure, build_targets, configure, sanitizer_rerun, student_warnings
 from .labs import build_features, lab_dirs, lab_targets, manifest, resolve_lab
 
@@ -49,7 +50,8 @@ class Grader:
         if not self.solutions:
             result.warnings = student_warnings(lab, output)
         suffix = "_tests_solution" if self.solutions else "_tests"
-        graded = grade.grade_lab(lab, BIN / (lab + suffix), ROOT, select, hidden=self.hidden, skip_tags=skip_tags())
+        graded = grade.grade_lab(lab, executable_path(lab + suffix), ROOT, select, hidden=self.hidden,
+                                 skip_tags=skip_tags())
         result.cases, result.errors = graded.cases, result.errors + graded.errors
         if self.sanitize and not self.solutions:
             for case in [c for c in result.cases if c.signal][:2]:
@@ -83,7 +85,8 @@ class Grader:
         lines = []
         for who, name in programs:
             try:
-                done = subprocess.run([str(BIN / name)], cwd=ROOT, capture_output=True, text=True,
+                done = subprocess.run([str(executable_path(name))], cwd=ROOT, capture_output=True,
+                                      encoding="utf-8", errors="replace",
                                       timeout=30, check=False)
                 text = (done.stdout.strip().splitlines() or [f"exit code {done.returncode}"])[0]
             except (OSError, subprocess.TimeoutExpired) as error:

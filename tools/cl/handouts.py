@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from . import grade
-from .base import BIN, ROOT, CourseError
+from .base import ROOT, CourseError
+from .base import program as executable_path
 from .build import BuildFailure, build_targets, configure
 from .labs import lab_dirs, manifest, resolve_lab
 
@@ -63,7 +64,7 @@ class PageResult:
 def page_commands(path):
     """The commands a page shows: indented or fenced code lines and inline code
     spans that start with ./course or build/bin/ (comments and `\\` joins undone)."""
-    lines = path.read_text().splitlines()
+    lines = path.read_text(encoding="utf-8").splitlines()
     found = []
     fenced = False
     pending = None
@@ -121,11 +122,12 @@ class Week:
 
 def check_program(program, args):
     """Run PROGRAM ARGS --check from the course root; the problem, or None."""
-    path = BIN / program
+    path = executable_path(program)
     if not path.is_file():
         return f"{program} is not built"
     try:
-        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True, text=True,
+        done = subprocess.run([str(path), "--check", *args], cwd=ROOT, capture_output=True,
+                              encoding="utf-8", errors="replace",
                               timeout=CHECK_SECONDS, check=False)
     except subprocess.TimeoutExpired:
         return f"--check ran past {CHECK_SECONDS} s (a path that does not stop at its start)"
@@ -266,7 +268,7 @@ def matching_cases(lab, pattern):
     """The lab's graded cases that `./course grade LAB -t PATTERN` would run."""
     if lab not in _CASES:
         # The student's and the reference's programs hold the same cases (compiled once, linked twice).
-        _CASES[lab] = grade.list_names(BIN / f"{lab}_tests", grade.lab_tag(lab))
+        _CASES[lab] = grade.list_names(executable_path(f"{lab}_tests"), grade.lab_tag(lab))
     selected = grade.case_filter(pattern)
     return [name for name in _CASES[lab] if selected(name)]
 

@@ -10,7 +10,7 @@ import shlex
 from pathlib import Path
 
 from . import grade
-from .base import BIN, BUILD, ROOT, CourseError, show
+from .base import BUILD, ROOT, CourseError, program, show
 
 MANIFEST = BUILD / "labs.json"
 
@@ -18,7 +18,7 @@ MANIFEST = BUILD / "labs.json"
 def manifest():
     """build/labs.json's "labs": {lab: {student, reference, info, deps, links}}."""
     try:
-        return json.loads(MANIFEST.read_text())["labs"]
+        return json.loads(MANIFEST.read_text(encoding="utf-8"))["labs"]
     except (OSError, ValueError, KeyError):
         return {}
 
@@ -37,7 +37,7 @@ def manifest_stale():
     labs = manifest()
     if not labs:
         return True
-    declared = (ROOT / "CMakeLists.txt").read_text()
+    declared = (ROOT / "CMakeLists.txt").read_text(encoding="utf-8")
     if any(lab not in labs and f"add_lab({lab} " in declared for lab in lab_dirs()):
         return True
     for lab, entry in labs.items():
@@ -62,7 +62,7 @@ def resolve_lab(token):
 
 
 def executable(name):
-    path = BIN / name
+    path = program(name)
     if not path.is_file():
         raise CourseError(f"{show(path)} not found (is it added in CMakeLists.txt?)")
     return path
@@ -87,7 +87,7 @@ def _demo_text_lines(lab):
     demo = ROOT / "labs" / lab / "demo.txt"
     if not demo.is_file():
         return []
-    lines = (line.strip() for line in demo.read_text().splitlines())
+    lines = (line.strip() for line in demo.read_text(encoding="utf-8").splitlines())
     return [line for line in lines if line and not line.startswith("#")]
 
 
@@ -139,7 +139,7 @@ def reject_lines(lab):
     if not path.is_file():
         return []
     found = []
-    for number, line in enumerate(path.read_text().splitlines(), 1):
+    for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), 1):
         line = line.strip()
         if not line or line.startswith("#"):
             continue

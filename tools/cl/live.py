@@ -10,7 +10,6 @@ a drag message to the first frame that shows the particle held there (the
 median of 50 drags), and the frames per second at speed 16 (as fast as the
 steps go)."""
 import json
-import os
 import re
 import statistics
 import subprocess
@@ -18,7 +17,7 @@ import sys
 import time
 
 from . import grade
-from .base import ROOT, CourseError
+from .base import ROOT, CourseError, become
 from .build import BuildFailure, build_targets, configure
 from .labs import executable, lab_dirs, resolve_lab
 
@@ -53,7 +52,7 @@ def has_live_mode(lab):
     """Whether the lab's program takes --live: its driver adds common/live.h's
     flag (the time-stepping labs do; the sweep labs 01-03 do not)."""
     main = ROOT / "labs" / lab / "main.cpp"
-    return main.is_file() and "add_live_option(" in main.read_text()
+    return main.is_file() and "add_live_option(" in main.read_text(encoding="utf-8")
 
 
 def read_url(process, seconds):
@@ -82,8 +81,9 @@ def bench(program, args):
     """Latency (s, median of 50 drags) and frames per second of `program --live ARGS`."""
     import websocket  # Debian's python3-websocket
     import tempfile
-    errors = tempfile.TemporaryFile(mode="w+")
-    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, stderr=errors, text=True)
+    errors = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
+    process = subprocess.Popen([str(program), *args], stdout=subprocess.PIPE, stderr=errors,
+                               encoding="utf-8", errors="replace")
     try:
         try:
             port, token = read_url(process, 30)
@@ -151,5 +151,4 @@ def cmd_live(argv):
         print(f"{name} {' '.join(args[2:])}: {n} particles; drag to frame {1e3 * latency:.2f} ms (median of 50); "
               f"{rate:.0f} frames/s received, {steps:.0f} steps/s at speed 16")
         return 0
-    sys.stdout.flush()
-    os.execv(str(program), [str(program), *args[1:]])
+    return become(program, [str(program), *args[1:]])

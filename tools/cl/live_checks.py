@@ -30,6 +30,7 @@ from .live_handouts import check_handouts
 from .live_hostile import IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile
 from .live_storm import MIN_FPS, STORM_RATE, STORM_RSS_BYTES, TINY_SOCKETS, check_storm
 from .live_stress import FLOOD, check_stress
+from .requirements import browser as find_browser
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
                   "--enable-unsafe-swiftshader", "--window-size=800,600", "--remote-debugging-port=0",
@@ -92,11 +93,11 @@ def start_chromium(chromium, url, profile):
                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
     port_file = Path(profile) / "DevToolsActivePort"
     end = time.monotonic() + 20
-    while not port_file.is_file() or not port_file.read_text().strip():
+    while not port_file.is_file() or not port_file.read_text(encoding="utf-8").strip():
         if time.monotonic() > end or process.poll() is not None:
             raise RuntimeError("Chromium did not open its DevTools port")
         time.sleep(0.05)
-    port = port_file.read_text().split()[0]
+    port = port_file.read_text(encoding="utf-8").split()[0]
     while True:
         pages = json.loads(urllib.request.urlopen(f"http://127.0.0.1:{port}/json/list", timeout=5).read())
         pages = [p for p in pages if p.get("type") == "page" and p.get("url", "").startswith("http://127.0.0.1")]
@@ -249,7 +250,7 @@ def drive(page, process, port, token):
 def check_live(checks):
     """lab 04's reference live on a 16² curtain, driven in headless Chromium."""
     program = BIN / "lab04_pbd_solution"
-    chromium = shutil.which("chromium")
+    chromium = find_browser()
     try:
         import websocket  # noqa: F401
     except ImportError:
@@ -293,7 +294,7 @@ def check_live(checks):
     stressing = threading.Thread(target=beside)
     stressing.start()
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live", "--summary", str(summary)],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, encoding="utf-8", errors="replace")
     problems, browser, page = [], None, None
     profile = scratch / "chromium-profile"
     try:
@@ -316,7 +317,7 @@ def check_live(checks):
             problems.append("the program was still running: killed")
         out, err = process.communicate()
     if summary.is_file():
-        knobs = json.loads(summary.read_text()).get("knobs", {})
+        knobs = json.loads(summary.read_text(encoding="utf-8")).get("knobs", {})
         if knobs.get("K") != 3:
             problems.append(f"the summary's knobs are {knobs}, not K = 3")
     else:

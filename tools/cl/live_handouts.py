@@ -19,7 +19,7 @@ class Session:
     def __init__(self, lab, args):
         import websocket  # Debian's python3-websocket
         self.process = subprocess.Popen([str(BIN / f"{lab}_solution"), "--live", *args], stdout=subprocess.PIPE,
-                                        stderr=subprocess.PIPE, text=True)
+                                        stderr=subprocess.PIPE, encoding="utf-8", errors="replace")
         port, token = read_url(self.process, 20)
         self.client = websocket.create_connection(f"ws://127.0.0.1:{port}/ws?token={token}", timeout=20)
         self.hello = json.loads(self.client.recv())

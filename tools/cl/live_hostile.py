@@ -237,7 +237,8 @@ def stop_during_step(program, how, scratch, timeout=20, env=None, prefix=()):
     summary = Path(scratch) / f"summary-{how}.json"
     summary.unlink(missing_ok=True)
     process = subprocess.Popen([*prefix, str(program), "--scene", "curtain-16", "--live", "--iterations", "100000000",
-                                "--summary", str(summary)], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                "--summary", str(summary)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                               encoding="utf-8",
                                errors="replace", env=env)
     problems, seconds, err = [], None, ""
     try:
@@ -260,7 +261,7 @@ def stop_during_step(program, how, scratch, timeout=20, env=None, prefix=()):
                             f"{'over 5' if code is None else f'{seconds:.2f}'} s (at most {STOP_SECONDS:.0f})")
         elif code != 0:
             problems.append(f"{how} during a 1e8-iteration step: exit {code}, not 0")
-        elif not summary.is_file() or json.loads(summary.read_text()).get("live") is not True:
+        elif not summary.is_file() or json.loads(summary.read_text(encoding="utf-8")).get("live") is not True:
             problems.append(f"{how} during a 1e8-iteration step: no summary written")
     except (RuntimeError, OSError, websocket.WebSocketException, ValueError) as error:
         problems.append(f"{how} during a 1e8-iteration step: {type(error).__name__}: {error}")
@@ -290,7 +291,7 @@ def check_hostile(program, scratch, start_seconds=20, bounded=True, env=None, pr
     for thread in stoppers:
         thread.start()
     process = subprocess.Popen([*prefix, str(program), "--scene", "curtain-16", "--live"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, errors="replace", env=env)
+                               stderr=subprocess.PIPE, encoding="utf-8", errors="replace", env=env)
     problems, numbers = [], {}
     try:
         port, token = read_url(process, start_seconds)

@@ -117,9 +117,12 @@ class Honest:
         return bins
 
 
+CONTEXT = multiprocessing.get_context("fork" if hasattr(os, "fork") else "spawn")
+
+
 def abuse(target, *args):
     """`target(*args)` in a process of its own, started."""
-    process = multiprocessing.get_context("fork").Process(target=target, args=args, daemon=True)
+    process = CONTEXT.Process(target=target, args=args, daemon=True)
     process.start()
     return process
 
@@ -129,7 +132,7 @@ def check_storm(program):
     import websocket  # Debian's python3-websocket
     from .live import read_url
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, errors="replace")
+                               stderr=subprocess.PIPE, encoding="utf-8", errors="replace")
     problems, numbers, abusers = [], {}, []
     try:
         port, token = read_url(process, 20)
@@ -142,7 +145,7 @@ def check_storm(program):
         if statistics.median(tiny) < MIN_FPS:
             problems.append(f"beside {TINY_SOCKETS} tiny-frame sockets the honest page's frames per second were "
                             f"{tiny}, median under {MIN_FPS}")
-        opens = multiprocessing.Value("l", 0)
+        opens = CONTEXT.Value("l", 0)
         abusers += [abuse(storm, port, token, STORM_RATE / 2, STORM_SECONDS, opens) for _ in range(2)]
         during = honest.frames(STORM_SECONDS)
         after = honest.frames(1.0)

@@ -120,7 +120,7 @@ def close_answer(sock, seconds=3.0):
 
 
 def rss(pid):
-    with open(f"/proc/{pid}/status") as status:
+    with open(f"/proc/{pid}/status", encoding="utf-8") as status:
         for line in status:
             if line.startswith("VmRSS:"):
                 return int(line.split()[1]) * 1024
@@ -342,7 +342,7 @@ def check_stress(program):
     import subprocess
     from .live import read_url
     process = subprocess.Popen([str(program), "--scene", "curtain-16", "--live"], stdout=subprocess.PIPE,
-                               stderr=subprocess.PIPE, text=True, errors="replace")
+                               stderr=subprocess.PIPE, encoding="utf-8", errors="replace")
     problems, numbers = [], {}
     try:
         port, token = read_url(process, 20)

@@ -23,7 +23,7 @@ def run_measurement(program, args, out, echo=True):
     command = [str(path), "--out", str(out / "bench"), *args]
     if echo:
         print("  " + shlex.join([path.name, *command[1:]]), flush=True)
-    done = subprocess.run(command, cwd=ROOT, capture_output=not echo, text=True, check=False)
+    done = subprocess.run(command, cwd=ROOT, capture_output=not echo, encoding="utf-8", errors="replace", check=False)
     return done.returncode, [] if echo else (done.stdout + done.stderr).splitlines()
 
 
@@ -108,7 +108,7 @@ TRADE_ACCURACY_COLUMNS = ("residual_rms", "relative_residual", "hard_violation_r
 def check_trade_accuracy(checks, table):
     """CI: every run of the quick trade has the residuals and the objective gap, finite."""
     try:
-        with open(table, newline="") as f:
+        with open(table, newline="", encoding="utf-8") as f:
             rows = list(csv.DictReader(f))
     except OSError as error:
         checks.record(False, f"trade --quick: {table} unreadable: {error}")
@@ -150,7 +150,7 @@ def check_micro(checks):
             return
         for name in targets:
             done = subprocess.run([str(executable(name)), "--benchmark_min_time=0.001"], cwd=ROOT,
-                                  capture_output=True, text=True, check=False)
+                                  capture_output=True, encoding="utf-8", errors="replace", check=False)
             runs = sum(1 for line in done.stdout.splitlines() if line.startswith("BM_"))
             ok = done.returncode == 0 and runs > 0
             checks.record(ok, f"{name}: {runs} benchmarks ran, about 1 ms each"

@@ -37,7 +37,7 @@ def catalogue(lab):
     path = ROOT / "solutions" / lab / "mistakes.json"
     if not path.is_file():
         return []
-    entries = json.loads(path.read_text())
+    entries = json.loads(path.read_text(encoding="utf-8"))
     for index, entry in enumerate(entries):
         missing = {"id", "what", "file", "find", "replace", "fails"} - set(entry)
         if missing:
@@ -47,10 +47,10 @@ def catalogue(lab):
 
 def write_if_changed(path, text):
     """Write `text` (a new mtime, so the build sees it) unless the file already holds it."""
-    if path.is_file() and path.read_text() == text:
+    if path.is_file() and path.read_text(encoding="utf-8") == text:
         return
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(text)
+    path.write_text(text, encoding="utf-8")
 
 
 def sync_tree():
@@ -58,7 +58,7 @@ def sync_tree():
     for relative in course_files():
         source = ROOT / relative
         try:
-            write_if_changed(TREE / relative, source.read_text())
+            write_if_changed(TREE / relative, source.read_text(encoding="utf-8"))
         except UnicodeDecodeError:
             target = TREE / relative
             target.parent.mkdir(parents=True, exist_ok=True)
@@ -76,7 +76,8 @@ def configure_tree():
     build_dir = TREE / "build"
     if not (build_dir / "CMakeCache.txt").is_file():
         done = subprocess.run(["cmake", "-S", str(TREE), "-B", str(build_dir), "-G", "Ninja",
-                               "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True, env=tree_env())
+                               "-DCMAKE_BUILD_TYPE=Release"], capture_output=True,
+                              encoding="utf-8", errors="replace", env=tree_env())
         if done.returncode != 0:
             raise CourseError("mistakes: the scratch tree does not configure", details=done.stdout.splitlines()[-10:])
 
@@ -85,7 +86,7 @@ def build(targets):
     build_dir = TREE / "build"
     configure_tree()
     done = subprocess.run(["cmake", "--build", str(build_dir), "--target", *targets, "-j", "2"],
-                          capture_output=True, text=True, env=tree_env())
+                          capture_output=True, encoding="utf-8", errors="replace", env=tree_env())
     errors = [line for line in done.stdout.splitlines() if "error" in line][:6]
     return done.returncode == 0, errors
 
@@ -96,7 +97,8 @@ def graded_cases(lab, program):
 
 def case_fails(program, name):
     try:
-        done = subprocess.run([str(program), name], capture_output=True, text=True, timeout=CASE_TIMEOUT)
+        done = subprocess.run([str(program), name], capture_output=True,
+                              encoding="utf-8", errors="replace", timeout=CASE_TIMEOUT)
     except subprocess.TimeoutExpired:
         return True
     return done.returncode != 0
@@ -135,7 +137,7 @@ def plant(lab, entry):
     source = ROOT / "solutions" / lab / entry["file"]
     if not source.is_file():
         return f"solutions/{lab}/{entry['file']}: no such reference file"
-    reference = source.read_text()
+    reference = source.read_text(encoding="utf-8")
     if reference.count(entry["find"]) != 1:
         return f"its 'find' occurs {reference.count(entry['find'])} times in {entry['file']}, not once"
     write_if_changed(planted_path(lab, entry), reference.replace(entry["find"], entry["replace"]))
@@ -145,7 +147,7 @@ def plant(lab, entry):
 def unplant(lab, entry):
     source = ROOT / "solutions" / lab / entry["file"]
     if source.is_file():
-        write_if_changed(planted_path(lab, entry), source.read_text())
+        write_if_changed(planted_path(lab, entry), source.read_text(encoding="utf-8"))
 
 
 def targets_of(lab, entry):
@@ -158,7 +160,7 @@ def reference_sources(targets):
     found = {}
     for target in targets:
         done = subprocess.run(["ninja", "-C", str(build_dir), "-t", "commands", target],
-                              capture_output=True, text=True, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", check=False)
         found[target] = set(re.findall(r"solutions/(lab\d\d_\w+?/\w+\.cpp)\b", done.stdout))
     return found
 
@@ -240,7 +242,7 @@ def plant_round(plants, every_case, log, lines):
 def troubleshooting_gaps(lab, entries):
     """Markers in the handout without an entry, and entries marked as
     Troubleshooting whose marker is not in the handout."""
-    page = (ROOT / "labs" / lab / "README.md").read_text()
+    page = (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8")
     marked = set(MARKER.findall(page))
     ids = {entry["id"] for entry in entries}
     gaps = [f"  FAIL the handout marks '{m}', which solutions/{lab}/mistakes.json does not have"

@@ -4,15 +4,22 @@ it, as `python3 plots/NAME.py DIR` would run it — its own process, __main__,
 its folder first on sys.path, its exit code and output — without paying the
 imports again (about 1 s of CPU a script, 36 s over the course's figures).
 
+Where there is no fork (Windows), or CL_PLOTS_SPAWN=1, each script instead
+runs as `python SCRIPT DIR` in a process of its own, paying the imports: the
+same result, slower.
+
 Protocol, one JSON object per line: a job {"script", "args", "env"} on stdin,
 its result {"code", "stdout", "stderr"} on stdout. Not a command of its own.
 """
 import json
 import os
 import runpy
+import subprocess
 import sys
 import tempfile
 import traceback
+
+FORK = hasattr(os, "fork") and os.environ.get("CL_PLOTS_SPAWN") != "1"
 
 
 def run_child(job):
@@ -41,8 +48,18 @@ def run_child(job):
     os._exit(code)
 
 
+def spawn_job(job):
+    """Run the job as `python SCRIPT ARGS` (no fork here); its result."""
+    env = dict(os.environ, **job["env"], PYTHONIOENCODING="utf-8")  # its prints as the fork's would be
+    done = subprocess.run([sys.executable, job["script"], *job["args"]], env=env,
+                          capture_output=True, encoding="utf-8", errors="replace", check=False)
+    return {"code": done.returncode, "stdout": done.stdout, "stderr": done.stderr}
+
+
 def run_job(job):
     """Fork, run the job in the child with its output in temporary files; its result."""
+    if not FORK:
+        return spawn_job(job)
     with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
         sys.stdout.flush()
         sys.stderr.flush()
@@ -60,9 +77,10 @@ def run_job(job):
 
 def main():
     os.environ.setdefault("MPLBACKEND", "Agg")
-    import matplotlib  # noqa: F401 (imported here once, for every child)
-    import matplotlib.pyplot  # noqa: F401
-    import numpy  # noqa: F401
+    if FORK:
+        import matplotlib  # noqa: F401 (imported here once, for every child)
+        import matplotlib.pyplot  # noqa: F401
+        import numpy  # noqa: F401
     for line in sys.stdin:  # a script's own prints go to its child's files, never here
         if line.strip():
             print(json.dumps(run_job(json.loads(line))), flush=True)

@@ -22,7 +22,8 @@ from .labs import lab_dirs, resolve_lab
 
 PLOT_SKIPPED = 4  # a plot script's exit code when its input is not in DIR (plots/_figures.py)
 PLOT_ERROR_LINES = 12  # of a failing plot script's stderr, shown
-PLOT_WORKERS = 2  # scripts drawn at once (each in a process forked from a runner, tools/cl/plot_worker.py)
+PLOT_WORKERS = 2  # scripts drawn at once (each in a process forked from a runner, tools/cl/plot_worker.py;
+#                   a process of its own where there is no fork)
 
 
 @dataclass
@@ -54,7 +55,7 @@ class PlotWorkers:
         self.idle = queue.Queue()
         self.processes = [subprocess.Popen([sys.executable, str(Path(__file__).with_name("plot_worker.py"))],
                                            cwd=ROOT, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                                           text=True) for _ in range(PLOT_WORKERS)]
+                                           encoding="utf-8", errors="replace") for _ in range(PLOT_WORKERS)]
         for process in self.processes:
             self.idle.put(process)
 

@@ -32,7 +32,8 @@ def course_files():
     """Paths (relative to ROOT) of every file of the course."""
     if (ROOT / ".git").exists() and shutil.which("git"):
         done = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z", "--cached", "--others",
-                               "--exclude-standard"], capture_output=True, text=True, check=False)
+                               "--exclude-standard"], capture_output=True,
+                              encoding="utf-8", errors="replace", check=False)
         if done.returncode == 0:
             return sorted(f for f in set(done.stdout.split("\0")) if f and (ROOT / f).is_file())
     skipped = SKIPPED_DIRS | {BUILD.name}
@@ -102,7 +103,7 @@ def write_marker(dest, lab, past):
     marker = {"release": lab, "references": past,
               "note": "stubs for every lab; solutions/ holds the reference code of the labs before "
                       f"{grade.lab_id(lab)} (docs/DESIGN.md §4)"}
-    (dest / RELEASE_MARKER).write_text(json.dumps(marker, indent=2) + "\n")
+    (dest / RELEASE_MARKER).write_text(json.dumps(marker, indent=2) + "\n", encoding="utf-8")
 
 
 def cmd_release(argv):

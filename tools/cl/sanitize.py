@@ -69,7 +69,7 @@ def configure_sanitized(log=sys.stdout):
     configure(log=log)  # labs.json says which labs have a reference
     # A Release build; CMakeLists.txt (CL_SANITIZE) gives the course's code its flags.
     cache = SANITIZE_BUILD / "CMakeCache.txt"
-    text = cache.read_text() if cache.is_file() else ""
+    text = cache.read_text(encoding="utf-8") if cache.is_file() else ""
     if "CL_SANITIZE:BOOL=ON" not in text or "CMAKE_BUILD_TYPE:STRING=Release" not in text:
         quiet(["cmake", "-S", str(ROOT), "-B", str(SANITIZE_BUILD), *generator_args(SANITIZE_BUILD),
                "-DCL_SANITIZE=ON", "-DCMAKE_BUILD_TYPE=Release"],
@@ -102,7 +102,7 @@ class BackgroundSuite:
         self.run_seconds = self.run_cpu = None
         self.results = None
         self.error = None
-        self.output = tempfile.TemporaryFile(mode="w+")
+        self.output = tempfile.TemporaryFile(mode="w+", encoding="utf-8")
         self.started = time.monotonic()
         # The instrumented libraries first; the test programs once the main
         # build is done (main_built): their own files are the main build's
@@ -128,7 +128,7 @@ class BackgroundSuite:
         # (Python before 3.11 has no process_group: a session, as before.)
         group = dict(process_group=0) if sys.version_info >= (3, 11) else dict(start_new_session=True)
         return subprocess.Popen(["nice", "-n", "10", *command], cwd=ROOT, stdout=self.output,
-                                stderr=subprocess.STDOUT, text=True, **group)
+                                stderr=subprocess.STDOUT, encoding="utf-8", errors="replace", **group)
 
     def start_second_phase(self):
         """The build's second phase, which becomes the build's process (send reaches it)."""
@@ -221,7 +221,7 @@ def descendants(pid):
     children = {}
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
-            text = stat.read_text()
+            text = stat.read_text(encoding="utf-8", errors="replace")
         except OSError:  # ended meanwhile
             continue
         parent = int(text[text.rfind(")") + 2:].split()[1])  # after "pid (name) state"
@@ -251,8 +251,9 @@ def run_program(name, nice=False, suite=None):
     env = dict(sanitizer_env(leaks=True), OMP_WAIT_POLICY="passive")
     start = time.monotonic()
     command = [*(["nice", "-n", "10"] if nice else []), str(SANITIZE_BUILD / "bin" / name)]
-    with tempfile.TemporaryDirectory(prefix="cl-asan-") as work, tempfile.TemporaryFile(mode="w+") as log:
-        options = dict(cwd=work, env=env, stdout=log, stderr=subprocess.STDOUT, text=True)
+    with tempfile.TemporaryDirectory(prefix="cl-asan-") as work, \
+            tempfile.TemporaryFile(mode="w+", encoding="utf-8") as log:
+        options = dict(cwd=work, env=env, stdout=log, stderr=subprocess.STDOUT, encoding="utf-8", errors="replace")
         if suite is None:
             code = subprocess.Popen(command, **options).wait()
         else:

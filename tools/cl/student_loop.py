@@ -17,7 +17,7 @@ def sub_course(tree, *args):
     """Run tree's own ./course (its tools/course.py) with its own build dir."""
     env = dict(os.environ, CL_BUILD_DIR=str(tree / "build"))
     done = subprocess.run([sys.executable, str(tree / "tools" / "course.py"), *args], cwd=tree, env=env,
-                          capture_output=True, text=True, check=False)
+                          capture_output=True, encoding="utf-8", errors="replace", check=False)
     return done.returncode, (done.stdout + done.stderr).splitlines()
 
 
@@ -25,7 +25,7 @@ def lab_scores(results_json):
     """{labNN: [score, max]} from a results.json."""
     scores = {}
     try:
-        data = json.loads(results_json.read_text())
+        data = json.loads(results_json.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return scores
     for test in data["tests"]:
@@ -45,7 +45,7 @@ def check_student_loop(checks):
         return
     lab1, lab3, lab4 = ids["lab01"], ids["lab03"], ids["lab04"]
     spring = ROOT / "solutions" / lab1 / "single_spring.cpp"
-    reference = spring.read_text()
+    reference = spring.read_text(encoding="utf-8")
     sign_error = reference.replace("correction.dx_i = -(", "correction.dx_i = (")
     bug = "  return (-constraint / denominator) * (gradients * inv_mass.asDiagonal());\n"
     crash = reference.replace(bug, "  Eigen::Matrix3Xd corrections;  // never sized: the bug\n"
@@ -64,7 +64,7 @@ def check_student_loop(checks):
                       f"release lab03: solutions/ holds {', '.join(shipped)} only")
 
         # 1. A sign error in lab 01 costs lab 01 points, lab 03 (reference code) none.
-        (tree / "labs" / lab1 / "single_spring.cpp").write_text(sign_error)
+        (tree / "labs" / lab1 / "single_spring.cpp").write_text(sign_error, encoding="utf-8")
         for source in (ROOT / "solutions" / lab3).glob("*.cpp"):
             shutil.copy2(source, tree / "labs" / lab3 / source.name)
         code, lines = sub_course(tree, "grade", "lab01", "lab03")
@@ -76,7 +76,7 @@ def check_student_loop(checks):
 
         # 2. Lab 04 does not compile: lab 01 still grades, lab 04 shows the error.
         pbd = tree / "labs" / lab4 / "pbd.cpp"
-        pbd.write_text(pbd.read_text() + "\nint this_line_does_not_compile = ;\n")
+        pbd.write_text(pbd.read_text(encoding="utf-8") + "\nint this_line_does_not_compile = ;\n", encoding="utf-8")
         code, lines = sub_course(tree, "grade", "lab01", "lab04")
         scores = lab_scores(tree / "build" / "grade" / "results.json")
         text = "\n".join(lines)
@@ -87,7 +87,7 @@ def check_student_loop(checks):
                       [] if ok else lines)
 
         # 3. A crash in lab 01 is rerun under the sanitizers, which name the line.
-        (tree / "labs" / lab1 / "single_spring.cpp").write_text(crash)
+        (tree / "labs" / lab1 / "single_spring.cpp").write_text(crash, encoding="utf-8")
         line = next(i for i, l in enumerate(crash.splitlines(), 1) if "corrections.col(k) =" in l)
         where = f"labs/{lab1}/single_spring.cpp:{line}"
         code, lines = sub_course(tree, "grade", "lab01")

@@ -3,8 +3,8 @@ trajectory (DIR/trajectory.json and .bin, written by --frames N), or of two
 runs side by side with one clock and one camera (docs/DESIGN.md §3, "The
 trajectory", and §7).
 
-The page inlines Debian's three.js (libjs-three) and its OrbitControls and
-embeds the data as base64, so it opens from disk with no server and no
+The page inlines the course's copy of three.js r111 and its OrbitControls
+(tools/cl/vendor/three/, from npm's three@0.111.0) and embeds the data as base64, so it opens from disk with no server and no
 network. It writes its state into <body>'s attributes (data-frames,
 data-particles, data-springs, data-frame, data-sample, data-ready, data-error)
 for the browser test in ./course test (checks.py).
@@ -18,8 +18,8 @@ from pathlib import Path
 
 from .base import CourseError, show, under_root
 
-THREE_DIR = Path("/usr/share/javascript/three")
-THREE_FILES = [THREE_DIR / "three.min.js", THREE_DIR / "examples/js/controls/OrbitControls.js"]
+THREE_DIR = Path(__file__).with_name("vendor") / "three"  # npm's three@0.111.0 (its README.md)
+THREE_FILES = [THREE_DIR / "three.min.js", THREE_DIR / "OrbitControls.js"]
 PLAYER = Path(__file__).with_name("view_player.js")
 
 
@@ -36,7 +36,7 @@ def load_run(folder):
     if not path.is_file():
         raise refuse(f"{show(folder)}: no trajectory.json (run the lab with --frames N --out {show(folder)})")
     try:
-        header = json.loads(path.read_text())
+        header = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, ValueError) as error:
         raise refuse(f"{show(path)}: not a trajectory ({error})") from None
     problem = header_problem(header)
@@ -105,8 +105,8 @@ def page(runs, title):
     """The HTML text: three.js, OrbitControls, the runs' data and the player."""
     for path in [*THREE_FILES, PLAYER]:
         if not path.is_file():
-            raise CourseError(f"{path} not found (install Debian's libjs-three: ./course installs it)")
-    scripts = "\n".join(f"<script>\n{path.read_text()}\n</script>" for path in THREE_FILES)
+            raise CourseError(f"{show(path)} not found (it is part of the course's tree)")
+    scripts = "\n".join(f"<script>\n{path.read_text(encoding='utf-8')}\n</script>" for path in THREE_FILES)
     data = []
     for r, (header, blob) in enumerate(runs):
         text = json.dumps(header, separators=(",", ":")).replace("</", "<\\/")
@@ -151,7 +151,7 @@ window.addEventListener('error', function (e) {{ document.body.setAttribute('dat
 <label><input id="loop" type="checkbox" checked> loop</label>
 </div>
 <script>
-{PLAYER.read_text()}
+{PLAYER.read_text(encoding="utf-8")}
 </script>
 </body></html>
 """
@@ -161,7 +161,7 @@ def write_atomic(path, text):
     path.parent.mkdir(parents=True, exist_ok=True)
     handle, temporary = tempfile.mkstemp(dir=path.parent, prefix=".view-", suffix=".html")
     try:
-        with os.fdopen(handle, "w") as out:
+        with os.fdopen(handle, "w", encoding="utf-8") as out:
             out.write(text)
         umask = os.umask(0)
         os.umask(umask)

@@ -14,6 +14,7 @@ import sys
 
 from .base import BIN, BUILD, ROOT
 from .labs import manifest
+from .requirements import browser as find_browser
 from .view import decode_positions, load_run, write_view
 
 CHROMIUM_FLAGS = ["--headless", "--disable-gpu", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
@@ -30,7 +31,7 @@ def open_in_chromium(chromium, page, frame, screenshot, size=(800, 600)):
     try:
         done = subprocess.run([chromium, *CHROMIUM_FLAGS, f"--window-size={size[0]},{size[1]}",
                                f"--screenshot={screenshot}", "--dump-dom", url],
-                              capture_output=True, text=True, timeout=60, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", timeout=60, check=False)
     except subprocess.TimeoutExpired:
         return {}, [f"{url}: Chromium ran past 60 s"]
     match = re.search(r"<body([^>]*)>", done.stdout)
@@ -116,11 +117,12 @@ def view_refusal_problems(scratch):
             shutil.copy(good / "trajectory.json", folder)
             (folder / "trajectory.bin").write_bytes((good / "trajectory.bin").read_bytes()[:-5])
         if name == "corrupt":
-            (folder / "trajectory.json").write_text((good / "trajectory.json").read_text()[:200])
+            cut = (good / "trajectory.json").read_text(encoding="utf-8")[:200]
+            (folder / "trajectory.json").write_text(cut, encoding="utf-8")
             shutil.copy(good / "trajectory.bin", folder)
         before = sorted(folder.iterdir())
         done = subprocess.run([sys.executable, str(ROOT / "tools" / "course.py"), "view", str(folder)],
-                              capture_output=True, text=True, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", check=False)
         lines = done.stderr.splitlines()
         if done.returncode != 2 or len(lines) != 1 or expected not in lines[0]:
             problems.append(f"view {name}: exit {done.returncode}, stderr {lines[:3]} (expected 2, one line "
@@ -134,15 +136,15 @@ def comparison_problems(scratch):
     """./course view A B without --output: the page goes to view-A-vs-B.html
     beside A, the path is printed, and A's own view.html is left alone."""
     own = scratch / "a" / "view.html"
-    own.write_text("a's own view")
+    own.write_text("a's own view", encoding="utf-8")
     done = subprocess.run([sys.executable, str(ROOT / "tools" / "course.py"), "view", str(scratch / "a"),
-                           str(scratch / "b")], capture_output=True, text=True, check=False)
+                           str(scratch / "b")], capture_output=True, encoding="utf-8", errors="replace", check=False)
     expected = scratch / "view-a-vs-b.html"
     problems = []
     if done.returncode != 0 or not expected.is_file() or expected.name not in done.stdout:
         problems.append(f"view a b: exit {done.returncode}, {expected.name} "
                         f"{'written' if expected.is_file() else 'not written'}, stdout {done.stdout.strip()[:200]!r}")
-    if own.read_text() != "a's own view":
+    if own.read_text(encoding="utf-8") != "a's own view":
         problems.append("view a b overwrote a/view.html")
     own.unlink()
     expected.unlink(missing_ok=True)
@@ -170,7 +172,7 @@ def check_browser(checks):
         runner = BIN / "lab14_contact_solution" if name == "drape" else program
         done = subprocess.run([str(runner), *args, "--out", str(scratch / name),
                                "--summary", str(scratch / f"{name}.json")],
-                              capture_output=True, text=True, check=False)
+                              capture_output=True, encoding="utf-8", errors="replace", check=False)
         if done.returncode != 0:
             checks.record(False, f"the view's runs: {runner.name} {shlex.join(args)} exited {done.returncode}",
                           done.stderr.splitlines()[-3:])
@@ -181,15 +183,15 @@ def check_browser(checks):
     problems = comparison_problems(scratch)
     checks.record(not problems, "./course view a b writes view-a-vs-b.html beside a and says so; a/view.html "
                   "is left alone", problems)
-    chromium = shutil.which("chromium")
+    chromium = find_browser()
     if not chromium:
-        print("skip  the view in a browser: chromium is not installed (./course installs Debian's chromium "
-              "when run as root; or: sudo apt-get install chromium)")
+        print("skip  the view in a browser: no chromium, chromium-browser or google-chrome on PATH (./course test "
+              "installs Debian's chromium when run as root)")
         return
 
     run_a = load_run(scratch / "a")
     last = run_a[0]["frame_count"] - 1
-    final = json.loads((scratch / "a.json").read_text())["positions"]
+    final = json.loads((scratch / "a.json").read_text(encoding="utf-8"))["positions"]
     single = write_view([scratch / "a"])
     problems, shots = [], []
     for frame in (0, last):

@@ -35,7 +35,7 @@ from cl.labs import manifest  # noqa: E402
 AUTOGRADER_ROOT = Path(os.environ.get("AUTOGRADER_ROOT", "/autograder"))
 SUBMISSION = AUTOGRADER_ROOT / "submission"
 RESULTS = AUTOGRADER_ROOT / "results" / "results.json"
-CONFIG = json.loads((HERE / "autograder.json").read_text())
+CONFIG = json.loads((HERE / "autograder.json").read_text(encoding="utf-8"))
 LAB = CONFIG["lab"]
 TAG = grade.lab_id(LAB)
 STATE = BUILD / "autograder"  # the case list and pristine stubs, written by setup
@@ -87,7 +87,8 @@ def setup():
     stubs.mkdir(parents=True, exist_ok=True)
     for student in students:
         shutil.copy2(TREE / student, stubs / Path(student).name)
-    (STATE / "cases.json").write_text(json.dumps({"student": students, "cases": cases}, indent=2) + "\n")
+    (STATE / "cases.json").write_text(json.dumps({"student": students, "cases": cases}, indent=2) + "\n",
+                                      encoding="utf-8")
     total = sum(case["points"] for case in cases)
     print(f"{LAB}: {len(cases)} graded cases ({len(hidden)} hidden), {grade.fmt_points(total)} points; "
           f"accepts {', '.join(Path(s).name for s in students)}; setup took {time.monotonic() - start:.0f} s")
@@ -129,7 +130,7 @@ class Report:
     def write(self, start, unfinished):
         RESULTS.parent.mkdir(parents=True, exist_ok=True)
         partial = RESULTS.with_suffix(".partial")
-        partial.write_text(json.dumps(self.results(start, unfinished), indent=2) + "\n")
+        partial.write_text(json.dumps(self.results(start, unfinished), indent=2) + "\n", encoding="utf-8")
         partial.replace(RESULTS)  # never a half-written results.json
 
 
@@ -191,7 +192,7 @@ def run():
     case_timeout = seconds("AUTOGRADER_CASE_TIMEOUT", CONFIG["case_timeout"])
     run_limit = seconds("AUTOGRADER_RUN_LIMIT", CONFIG["run_limit"])
     deadline = start + run_limit
-    state = json.loads((STATE / "cases.json").read_text())
+    state = json.loads((STATE / "cases.json").read_text(encoding="utf-8"))
     report = Report(state["cases"])
     # First a valid results.json that says the run did not finish; overwritten at the end.
     report.notes.append(f"The autograder did not finish within {whole(run_limit)} s; "
