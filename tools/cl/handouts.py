@@ -34,7 +34,7 @@ from .labs import lab_dirs, manifest, resolve_lab
 INSTRUCTOR_COMMANDS = {"bench", "extremes", "fuzz", "sanitize", "release", "autograder"}
 INSTRUCTOR_PROGRAMS = re.compile(r"^(trade|extremes|bench_\w+)$")
 INSTRUCTOR_LINES = 4
-STUDENT_COMMANDS = {"demo", "test", "help", "run", "live", "grade", "plots", "view", "handouts", "claims"}
+STUDENT_COMMANDS = {"setup", "demo", "test", "help", "run", "live", "grade", "plots", "view", "handouts", "claims"}
 INSTRUCTOR_COMMANDS |= {"mistakes"}
 # A usage line, not a command: a placeholder in capitals (DIR, PATTERN, ARGS) or labNN.
 TEMPLATE = re.compile(r"\b(labNN\w*|[A-Z]{2,}[A-Z0-9_]*)\b|…|\.\.\.")
