@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
 #include <list>
 #include <map>
@@ -88,14 +89,30 @@ std::string live_token() {
   return token;
 }
 
+std::string live_forwarded_host(int port, const char* codespace, const char* domain) {
+  if (codespace == nullptr || domain == nullptr || *codespace == '\0' || *domain == '\0') return "";
+  return std::string(codespace) + "-" + std::to_string(port) + "." + domain;
+}
+
+namespace {
+// The name a GitHub Codespace forwards this port under, from its environment ("" elsewhere).
+std::string codespace_host(int port) {
+  return live_forwarded_host(port, std::getenv("CODESPACE_NAME"), std::getenv("GITHUB_CODESPACES_PORT_FORWARDING_DOMAIN"));
+}
+}  // namespace
+
 bool live_origin_allowed(const std::optional<std::string>& origin, int port) {
   const std::string tail = ":" + std::to_string(port);
-  return !origin || *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail;
+  const std::string forwarded = codespace_host(port);
+  return !origin || *origin == "http://127.0.0.1" + tail || *origin == "http://localhost" + tail ||
+         (!forwarded.empty() && *origin == "https://" + forwarded);
 }
 
 bool live_host_allowed(const std::string& host, int port) {
   const std::string tail = ":" + std::to_string(port);
-  return host == "127.0.0.1" + tail || host == "localhost" + tail || (port == 80 && (host == "127.0.0.1" || host == "localhost"));
+  const std::string forwarded = codespace_host(port);
+  return host == "127.0.0.1" + tail || host == "localhost" + tail || (port == 80 && (host == "127.0.0.1" || host == "localhost")) ||
+         (!forwarded.empty() && host == forwarded);
 }
 
 bool live_token_matches(const std::optional<std::string>& query, const std::string& token) {

@@ -89,13 +89,21 @@ class LiveServer {
 // 128 random bits as 32 hex digits (std::random_device).
 std::string live_token();
 
+// The host name a GitHub Codespace forwards `port` under, NAME-PORT.DOMAIN,
+// from its CODESPACE_NAME and GITHUB_CODESPACES_PORT_FORWARDING_DOMAIN; "" when
+// either is missing (not in a codespace). The page reached through it is
+// served too (the token still guards it): the dev container's live page.
+std::string live_forwarded_host(int port, const char* codespace, const char* domain);
+
 // Whether `origin` (the WebSocket's Origin header, every byte of it; none:
 // not given) may connect to a server on `port`: none (a client that is not a
-// browser), or http://127.0.0.1:PORT or http://localhost:PORT exactly.
+// browser), http://127.0.0.1:PORT or http://localhost:PORT exactly, or in a
+// codespace https:// and the name it forwards the port under.
 bool live_origin_allowed(const std::optional<std::string>& origin, int port);
 
 // Whether `host` (a request's Host header) names this server on `port`:
-// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80).
+// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80),
+// or in a codespace the name it forwards the port under (live_forwarded_host).
 // A page of another name that resolves to 127.0.0.1 (DNS rebinding) is refused.
 bool live_host_allowed(const std::string& host, int port);
 

@@ -38,6 +38,16 @@ TEST_CASE("live server accepts only the run's token, its own Origin and its own 
   CHECK(cl::live_host_allowed("localhost", 80));
 }
 
+TEST_CASE("live server names the host a codespace forwards its port under, and only there", "[live]") {
+  CHECK(cl::live_forwarded_host(8765, "fuzzy-space-abc123", "app.github.dev") == "fuzzy-space-abc123-8765.app.github.dev");
+  CHECK(cl::live_forwarded_host(8765, nullptr, "app.github.dev").empty());  // not in a codespace
+  CHECK(cl::live_forwarded_host(8765, "fuzzy-space-abc123", nullptr).empty());
+  CHECK(cl::live_forwarded_host(8765, "", "app.github.dev").empty());
+  // Outside a codespace (this test's environment has neither variable) no such name is let in.
+  CHECK_FALSE(cl::live_host_allowed("fuzzy-space-abc123-8765.app.github.dev", 8765));
+  CHECK_FALSE(cl::live_origin_allowed("https://fuzzy-space-abc123-8765.app.github.dev", 8765));
+}
+
 TEST_CASE("live server finds a folded header line wherever it is", "[live]") {
   CHECK(cl::live_head_folded("GET / HTTP/1.1\r\nHost: 127.0.0.1:8123\r\n x\r\n\r\n"));
   CHECK(cl::live_head_folded("GET / HTTP/1.1\r\nX-A: a\r\n\tb\r\nHost: 127.0.0.1:8123\r\n\r\n"));
