@@ -1,11 +1,9 @@
 #include "common/live.h"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -35,9 +33,6 @@
 namespace cl {
 
 namespace {
-
-std::atomic<bool> live_stop_requested{false};
-extern "C" void live_on_signal(int) { live_stop_requested = true; }
 
 std::string read_text(const std::string& path, const char* hint) {
   std::ifstream in(path, std::ios::binary);
@@ -174,14 +169,6 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   LiveServer server(options.port, live_page());
   std::printf("%s\n", server.url().c_str());
   std::fflush(stdout);
-  live_stop_requested = false;
-  struct sigaction action {};
-  struct sigaction old_int {};
-  struct sigaction old_term {};
-  action.sa_handler = live_on_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, &old_int);
-  sigaction(SIGTERM, &action, &old_term);
 
   std::map<int, Hold> holds;   // by particle
   std::map<int, long> sent;    // per client: the version of the state it was last sent
@@ -202,6 +189,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   double energy_start = 0.0, energy_limit = 0.0, energy_now = energy_of(state);
   StrainStats strain = strain_stats(state.x, scene.springs);
   Clock::time_point next_due = Clock::now();
+  auto stopping = [&] { return stop || server.stop_requested(); };  // the page's stop, Ctrl-C or SIGTERM
 
   auto send_error = [&](int client, const std::string& line) {
     live_log(line);  // a page that floods the run with bad messages gets its answers; stderr a summary
@@ -219,19 +207,25 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     changed = rebase = true;
     ++version;
   };
-  auto hello = [&](int client) {
-    greeted.insert(client);
+  // The hello's fixed part (the mesh, the command), built once: a page greeted costs the knobs' JSON.
+  const std::string hello_fixed = [&] {
     nlohmann::json springs = nlohmann::json::array(), rest = nlohmann::json::array();
     for (const Spring& spring : scene.springs) springs.push_back(spring.i), springs.push_back(spring.j), rest.push_back(spring.rest_length);
     nlohmann::json triangles = nlohmann::json::array();
     for (const Triangle& triangle : scene.triangles) {
       triangles.push_back(triangle.i), triangles.push_back(triangle.j), triangles.push_back(triangle.k);
     }
-    server.send_text(client, live_json_text(nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
-                                            {"method", run.method}, {"particles", n}, {"springs", springs},
-                                            {"triangles", triangles}, {"rest_lengths", rest}, {"knobs", nlohmann::json::parse(knobs.json())},
-                                            {"energy_name", run.energy_name}, {"command", command_line()},
-                                            {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}}));
+    std::string text = live_json_text(nlohmann::json{{"type", "hello"}, {"lab", run.lab}, {"scene", scene.name},
+                                                     {"method", run.method}, {"particles", n}, {"springs", springs},
+                                                     {"triangles", triangles}, {"rest_lengths", rest},
+                                                     {"energy_name", run.energy_name}, {"command", command_line()},
+                                                     {"colliders", nlohmann::json::parse(colliders_json(scene.colliders))}});
+    text.pop_back();  // the closing brace: the knobs go after
+    return text + ",\"knobs\":";
+  }();
+  auto hello = [&](int client) {
+    greeted.insert(client);
+    server.send_text(client, hello_fixed + knobs.json() + "}");
     if (!problem.empty()) {  // a page opened after the run stopped sees why (its frame follows: the last good one)
       server.send_text(client, live_json_text(nlohmann::json{{"type", "problem"}, {"frame", frame}, {"text", problem_line}}));
     }
@@ -370,7 +364,8 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
   };
 
   auto take_messages = [&] {
-    for (const LiveInbound& inbound : server.take_inbound()) {
+    for (const LiveInbound& inbound : server.take_inbound()) {  // a bounded number a turn
+      if (stopping()) return;
       try {
         apply(inbound);
       } catch (const std::exception& error) {  // one message's failure is its page's error, never the run's end
@@ -422,7 +417,7 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     while (!stepper.wait(0.02)) {  // the step goes on: the loop takes messages and watches for a stop
       take_messages();
       live_log_flush();
-      if ((stop || live_stop_requested) && stop_seen < 0.0) stop_seen = under_way.seconds();
+      if (stopping() && stop_seen < 0.0) stop_seen = under_way.seconds();
       if (stop_seen >= 0.0 && under_way.seconds() > stop_seen + kStopGraceSeconds) {
         // The step cannot be interrupted (it is the lab's code) and the run does not wait for it: the
         // summary is of the last completed step, and the process ends here, the step's thread with it.
@@ -527,9 +522,9 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     }
   };
 
-  while (!stop && !live_stop_requested) {
+  while (!stopping()) {
     take_messages();
-    if (stop) break;
+    if (stopping()) break;
     const Clock::time_point now = Clock::now();
     if (step_once || (!paused && problem.empty() && now >= next_due)) {
       step_once = false;
@@ -544,8 +539,6 @@ int run_live(Scene& scene, const LiveOptions& options, const LiveRun& run, const
     const double wait = paused ? 0.05 : std::chrono::duration<double>(next_due - Clock::now()).count();
     server.wait_inbound(std::min(std::max(wait, 0.0), 0.05));
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
   end_run(state);
   return 0;
 }

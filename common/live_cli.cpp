@@ -1,6 +1,7 @@
 // `--live [PORT]`: the one flag of the live mode. It takes an optional value,
 // which cl::CommandLine's option types do not offer, so this file includes
-// CLI11 as common/cli.cpp does (both compile in common's first unity batch).
+// CLI11 as common/cli.cpp does. It is cl_live's (CMakeLists.txt), built with
+// or without Boost: every live lab's main.cpp registers the flag.
 #include <CLI/CLI.hpp>
 
 #include "common/live.h"

@@ -28,14 +28,33 @@ const std::vector<std::pair<const char*, std::vector<const char*>>>& live_comman
   return fields;
 }
 
+// Whether the UTF-8 bytes at text[at] start a character an error line must
+// not show as itself; its length in bytes, 0 when it may be shown. C0 and DEL
+// (a "\n" in a JSON string breaks the line), C1 (U+0080-U+009F: U+009B is a
+// terminal's CSI), the bidi controls (U+202A-U+202E, U+2066-U+2069: they
+// reorder the rest of the line as a terminal or the page shows it) and the
+// line and paragraph separators U+2028, U+2029.
+std::size_t hidden_character(const std::string& text, std::size_t at) {
+  const auto byte = [&text](std::size_t i) { return i < text.size() ? static_cast<unsigned char>(text[i]) : 0u; };
+  const unsigned first = byte(at);
+  if (first < 0x20 || first == 0x7f) return 1;
+  if (first == 0xc2 && byte(at + 1) >= 0x80 && byte(at + 1) <= 0x9f) return 2;
+  if (first == 0xe2 && byte(at + 1) == 0x80 && byte(at + 2) >= 0xa8 && byte(at + 2) <= 0xae) return 3;
+  if (first == 0xe2 && byte(at + 1) == 0x81 && byte(at + 2) >= 0xa6 && byte(at + 2) <= 0xa9) return 3;
+  return 0;
+}
+
 // A name from the message, as an error line may quote it: at most 40 bytes,
 // cut where a character starts (a cut inside a UTF-8 character made the
-// reply's JSON invalid), control characters (a "\n" in a JSON string) as '?',
-// so the line stays one line.
+// reply's JSON invalid), each character hidden_character names as one '?',
+// so the line stays one line and reads in its own order.
 std::string quoted(const std::string& text) {
-  std::string shown = live_cut_utf8(text, 40);
-  for (char& c : shown) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  const std::string cut = live_cut_utf8(text, 40);
+  std::string shown;
+  for (std::size_t at = 0; at < cut.size();) {
+    const std::size_t hidden = hidden_character(cut, at);
+    shown += hidden > 0 ? std::string("?") : cut.substr(at, 1);
+    at += hidden > 0 ? hidden : 1;
   }
   return "'" + shown + "'";
 }

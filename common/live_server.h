@@ -1,31 +1,17 @@
 #pragma once
-// The live mode's server (docs/DESIGN.md §3, "The live mode"): a small HTTP
-// and WebSocket (RFC 6455) server on 127.0.0.1 only, one thread with
-// non-blocking sockets and poll(). GET /?token=T serves the page, /ws?token=T
-// is the page's WebSocket; neither answers without the run's token (403). A
-// request whose Host is not this server's (403), one that gives a header the
-// server reads twice (400), a head over kRequestCap (431) and a WebSocket
-// whose Origin is not this server's (403) are refused too.
-//
-// One slow or noisy client must never stall the run or another client, so:
-// the live loop (common/live.h) never touches a socket (it fills per-client
-// outboxes; a frame waiting replaces the one before, the newest wins); a
-// client whose outbox does not drain for kStalledSeconds, or with more than
-// kOutboxBytes queued toward it (everything but its frame), is dropped with
-// one line; one pending pong answers its pings, and at most
-// kControlsPerSecond control frames a second are read from it; each client's
-// messages wait in its own queue of at most kInboundPerClient, and while it is
-// full the server reads no more from that client (TCP holds the rest, so
-// nothing is lost, an ack included); take_inbound takes from every client in
-// turn. A frame is refused by the length its header declares, before its
-// payload is read (the payload is discarded as it comes); binary messages are
-// refused, fragmented text messages assembled. Connections are bounded:
-// kMaxClients WebSockets (a new one evicts the one heard from least
-// recently), kMaxPending connections still sending their request (a new one
-// evicts the oldest), each given kRequestSeconds to send it.
-#include <array>
+// The live mode's server (docs/DESIGN.md §3, "The live mode", says where each
+// limit lives): Boost.Beast over Asio, one io_context thread, on 127.0.0.1
+// only. Beast owns HTTP and RFC 6455; this is the course's policy. GET
+// /?token=T serves the page, /ws?token=T is its WebSocket; a wrong token, Host
+// or Origin is refused (403), as are a header read twice or a folded line
+// (400), a head over kRequestCap (431) and more than kNewSocketsPerSecond new
+// WebSockets a second (503). The live loop (common/live.h) never touches a
+// socket: it fills per-client outboxes, where the newest frame replaces the
+// one waiting; a client that takes nothing for kStalledSeconds, or has over
+// kOutboxBytes waiting (its frame aside), is dropped; its messages wait in a
+// queue of kInboundPerClient, and while that is full it is not read (TCP
+// holds the rest, none is lost).
 #include <cstddef>
-#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -45,8 +31,9 @@ struct LiveInbound {
 
 class LiveServer {
  public:
-  // Listens on 127.0.0.1:port (0: a free port) and serves `page` (HTML) at
-  // "/". Throws InputError when it cannot listen (the port in use).
+  // Listens on 127.0.0.1:port (0: a free port), serves `page` (HTML) at "/"
+  // and watches SIGINT and SIGTERM (stop_requested). Throws InputError when it
+  // cannot listen (the port in use).
   LiveServer(int port, std::string page);
   ~LiveServer();  // closes every connection and stops the server's thread
   LiveServer(const LiveServer&) = delete;
@@ -57,10 +44,14 @@ class LiveServer {
   std::string url() const;  // http://127.0.0.1:PORT/?token=T
 
   // The messages, openings and closings since the last call: at most
-  // kTakePerClient of each client's, the clients in turn, each client's in order.
+  // kTakePerClient of each client's and kTakePerTurn in all, the clients in
+  // turn, each client's in order. The opening of a client that has gone
+  // already is left out (its closing is not).
   std::vector<LiveInbound> take_inbound();
-  // Waits up to `seconds` for an inbound message (returns at once if one is queued).
+  // Waits up to `seconds` for an inbound message or a stop (returns at once if one is there).
   void wait_inbound(double seconds);
+  // Whether SIGINT or SIGTERM came.
+  bool stop_requested() const;
 
   // A text message to one client (client < 0: to every client). Never blocks.
   void send_text(int client, const std::string& text);
@@ -76,36 +67,43 @@ class LiveServer {
   static constexpr int kFramesInFlight = 2;
   static constexpr int kMaxClients = 16;
   static constexpr int kMaxPending = 32;
+  static constexpr int kNewSocketsPerSecond = 50;
   static constexpr double kRequestSeconds = 3.0;
   static constexpr std::size_t kRequestCap = 8192;  // bytes of a request's head
   static constexpr std::size_t kInboundPerClient = 64;
   static constexpr std::size_t kTakePerClient = 32;
+  static constexpr std::size_t kTakePerTurn = 256;
   static constexpr std::size_t kOutboxBytes = std::size_t{1} << 20;
+  static constexpr std::size_t kSendBufferBytes = std::size_t{256} << 10;  // the kernel's queue of a WebSocket
   static constexpr double kStalledSeconds = 5.0;
-  static constexpr double kPingSeconds = 2.0;
-  static constexpr double kSilentSeconds = 20.0;  // a WebSocket that answers nothing, not even a ping
-  static constexpr int kControlsPerSecond = 32;    // control frames (ping, pong) read from one client a second
+  static constexpr double kSilentSeconds = 20.0;  // Beast's idle timeout: pinged at half, closed at the end
 
-  struct Shared;  // the queues both threads touch (live_server.cpp)
-  struct Loop;    // the server thread's own state
+  struct State;  // the queues both threads share, and the server thread's own (live_server.cpp)
 
  private:
   std::string token_;
   int port_ = 0;
-  std::unique_ptr<Shared> shared_;
-  std::unique_ptr<Loop> loop_;
+  std::unique_ptr<State> state_;
 };
 
 // 128 random bits as 32 hex digits (std::random_device).
 std::string live_token();
 
+// The host name a GitHub Codespace forwards `port` under, NAME-PORT.DOMAIN,
+// from its CODESPACE_NAME and GITHUB_CODESPACES_PORT_FORWARDING_DOMAIN; "" when
+// either is missing (not in a codespace). The page reached through it is
+// served too (the token still guards it): the dev container's live page.
+std::string live_forwarded_host(int port, const char* codespace, const char* domain);
+
 // Whether `origin` (the WebSocket's Origin header, every byte of it; none:
 // not given) may connect to a server on `port`: none (a client that is not a
-// browser), or http://127.0.0.1:PORT or http://localhost:PORT exactly.
+// browser), http://127.0.0.1:PORT or http://localhost:PORT exactly, or in a
+// codespace https:// and the name it forwards the port under.
 bool live_origin_allowed(const std::optional<std::string>& origin, int port);
 
 // Whether `host` (a request's Host header) names this server on `port`:
-// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80).
+// 127.0.0.1:PORT or localhost:PORT (either without the port when it is 80),
+// or in a codespace the name it forwards the port under (live_forwarded_host).
 // A page of another name that resolves to 127.0.0.1 (DNS rebinding) is refused.
 bool live_host_allowed(const std::string& host, int port);
 
@@ -113,31 +111,16 @@ bool live_host_allowed(const std::string& host, int port);
 // given) carries token=`token`.
 bool live_token_matches(const std::optional<std::string>& query, const std::string& token);
 
+// Whether a request's head (its bytes up to the blank line) folds a header
+// line (obs-fold, RFC 7230 §3.2.4: a line that starts with a space or a tab),
+// which the server refuses (400) where Beast would join the lines.
+bool live_head_folded(const std::string& head);
+
 // One line to stderr, at most kLiveLogPerSecond a second from the whole
 // program: the rest are counted, and live_log_flush() (or the next line once
 // the second is over) prints "live: N more lines like these ... not shown".
 constexpr int kLiveLogPerSecond = 10;
 void live_log(const std::string& line);
 void live_log_flush(bool final = false);  // final: the summary now, whatever the time
-
-// The WebSocket wire format (RFC 6455), pure functions for the unit tests.
-// A frame's header at the front of `data`: complete false when more bytes are
-// needed; `bad` when it is one no client may send (reserved bits, a control
-// frame that is fragmented or longer than 125 bytes, a length with its top bit set).
-struct WebSocketHeader {
-  bool complete = false;
-  bool bad = false;
-  bool fin = false;
-  int opcode = 0;
-  bool masked = false;
-  std::uint64_t length = 0;  // the payload's, as declared
-  std::size_t size = 0;      // the header's own bytes
-  std::array<unsigned char, 4> mask{};
-};
-WebSocketHeader parse_websocket_header(const char* data, std::size_t size);
-// A server's (unmasked, final) frame of `opcode` around `payload`.
-std::string websocket_frame(int opcode, const char* payload, std::size_t size);
-// Sec-WebSocket-Accept for a client's Sec-WebSocket-Key: base64(SHA-1(key + GUID)).
-std::string websocket_accept(const std::string& key);
 
 }  // namespace cl

@@ -2,7 +2,8 @@
 labNN_solution, the reference) stepping its scene live beside a page in the
 browser (docs/DESIGN.md §3, "The live mode"). Builds the lab if needed, then
 becomes the program (`--live [PORT]`): it prints the page's URL and runs
-until Ctrl-C, SIGTERM or the page's stop.
+until Ctrl-C, SIGTERM or the page's stop. Without --port, CL_LIVE_PORT names
+the port (the dev container sets it: one port VS Code forwards for every run).
 
 `--bench` instead runs it in the background and measures, as a page would
 see it (a WebSocket client that acknowledges every frame): the latency from
@@ -10,6 +11,7 @@ a drag message to the first frame that shows the particle held there (the
 median of 50 drags), and the frames per second at speed 16 (as fast as the
 steps go)."""
 import json
+import os
 import re
 import statistics
 import subprocess
@@ -40,6 +42,11 @@ def live_command(argv):
             port = [value]
             del rest[at:at + (1 if "=" in word else 2)]
             break
+    if not port and os.environ.get("CL_LIVE_PORT"):  # the dev container's forwarded port
+        value = os.environ["CL_LIVE_PORT"]
+        if not value.isdigit() or not 1 <= int(value) <= 65535:
+            raise CourseError(f"live: CL_LIVE_PORT needs a number in [1, 65535], not {value!r}", code=2)
+        port = [value]
     if not has_live_mode(lab):
         live_labs = ", ".join(grade.lab_id(other) for other in lab_dirs() if has_live_mode(other))
         raise CourseError(f"live: {grade.lab_id(lab)} does not step in time, so it has no live mode "

@@ -10,7 +10,8 @@ disconnects mid-drag (the server runs on), the refusals of a request without
 the token and of a foreign Origin, and the page's stop (exit 0, the summary
 with the new K). Beside it, on programs of their own: the stress of
 tools/cl/live_stress.py, the handouts' live sections, then the hostile
-client's cases (tools/cl/live_hostile.py)."""
+client's cases (tools/cl/live_hostile.py), then the tiny frames and the
+reconnection storm (tools/cl/live_storm.py)."""
 import json
 import math
 import os
@@ -27,6 +28,7 @@ from .base import BIN, BUILD
 from .live import read_url
 from .live_handouts import check_handouts
 from .live_hostile import IDLE_SOCKETS, PING_MIN_FPS, PING_RSS_BYTES, check_hostile
+from .live_storm import MIN_FPS, STORM_RATE, STORM_RSS_BYTES, TINY_SOCKETS, check_storm
 from .live_stress import FLOOD, check_stress
 from .requirements import browser as find_browser
 
@@ -282,6 +284,12 @@ def check_live(checks):
         except Exception as error:  # noqa: BLE001
             stress["hostile"] = ([f"the hostile cases: {type(error).__name__}: {error}"], {})
         stress["hostile_seconds"] = time.monotonic() - hostile_started
+        storm_started = time.monotonic()  # last: it keeps a core busy for its 17 s
+        try:
+            stress["storm"] = check_storm(program)
+        except Exception as error:  # noqa: BLE001
+            stress["storm"] = ([f"the storm: {type(error).__name__}: {error}"], {})
+        stress["storm_seconds"] = time.monotonic() - storm_started
 
     stressing = threading.Thread(target=beside)
     stressing.start()
@@ -347,9 +355,19 @@ def check_live(checks):
         "hostile" in stress and not hostile_problems,
         f"live against a hostile local client ({stress.get('hostile_seconds', 0):.0f} s): names cut inside a UTF-8 "
         f"character answered (not exit 1); a 60 kB head in one write 431, a foreign Host 403, none 400, two Origins "
-        f"400, a NUL inside Origin 403; {IDLE_SOCKETS} idle sockets, then the page and a hello within 2 s; a ping flood "
+        f"400, a NUL inside Origin, a folded header line and 'Host :' 400; close codes 999, 1005, 5000, a "
+        f"1-byte close body and a reason not UTF-8 closed 1002; C1 and bidi controls in a name shown as '?'; {IDLE_SOCKETS} idle sockets, then the page and a hello within 2 s; a ping flood "
         f"reading 64 kB every 0.3 s: RSS +{numbers.get('ping_rss_rise_mb', 0):.1f} MB (at most "
         f"{PING_RSS_BYTES >> 20}), the honest page {numbers.get('ping_honest_fps')} frames/s (median, at least "
         f"{PING_MIN_FPS}); SIGINT and the page's stop during a 1e8-iteration step: exit 0 with the summary after "
         f"{seconds('SIGINT_seconds')} and {seconds('stop_seconds')} (at most 1 s)",
         hostile_problems)
+    storm_problems, numbers = stress.get("storm", (["the storm did not finish"], {}))
+    checks.record(
+        "storm" in stress and not storm_problems,
+        f"live under floods ({stress.get('storm_seconds', 0):.0f} s): beside {TINY_SOCKETS} tiny-frame sockets the "
+        f"honest page got {numbers.get('tiny_fps')} frames/s; during {STORM_RATE} WebSocket opens a second "
+        f"{numbers.get('storm_fps')}, in the second after {numbers.get('after_fps')} (at least {MIN_FPS} each); RSS "
+        f"+{numbers.get('rss_rise_mb', 0):.1f} MB (at most {STORM_RSS_BYTES >> 20}); the page's stop during a storm: "
+        f"{numbers.get('stop_seconds', 0):.2f} s (at most 1)",
+        storm_problems)

@@ -3,21 +3,23 @@
 
 check_hostile runs the cases of a hostile local client, each of which
 once ended the run or grew it without bound: names cut inside a UTF-8
-character, request heads the server must refuse, 60 idle sockets (./course
-sanitize runs them under ASan), a ping flood beside an honest page, and SIGINT
-and the page's stop during a step of minutes."""
+character, request heads the server must refuse, RFC answers to broken close
+frames and header lines, control characters in a quoted name, 60 idle
+sockets (./course sanitize runs them under ASan), a ping flood beside an
+honest page, and SIGINT and the page's stop during a step of minutes."""
 
 import base64
 import json
 import os
 import socket
 import statistics
+import struct
 import threading
 import time
 import urllib.request
 from pathlib import Path
 
-from .live_stress import PAGE_SECONDS, frame, open_socket, read_messages, rss
+from .live_stress import PAGE_SECONDS, close_answer, frame, open_socket, read_messages, rss
 
 # Each case below is named by what it sends; each broke the server before the fix it checks.
 
@@ -63,7 +65,7 @@ def cut_utf8_names(port, token):
 
 def head_refusals(port, token):
     """A 60 kB request head in one write (431), a foreign Host (403), two Origin headers (400) and an
-    Origin with a NUL inside (403): each refused, where each used to be served."""
+    Origin with a NUL inside (400: Beast's parser refuses the byte): each refused, where each used to be served."""
     host = f"127.0.0.1:{port}"
     ws = (f"GET /ws?token={token} HTTP/1.1\r\nHost: {host}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
           f"Sec-WebSocket-Key: {base64.b64encode(os.urandom(16)).decode()}\r\nSec-WebSocket-Version: 13\r\n").encode()
@@ -74,7 +76,7 @@ def head_refusals(port, token):
         ("no Host", "400", f"GET /?token={token} HTTP/1.1\r\n\r\n".encode()),
         ("two Origin headers, a foreign one first", "400",
          ws + f"Origin: http://evil.example\r\nOrigin: http://{host}\r\n\r\n".encode()),
-        ("an Origin with a NUL inside", "403", ws + f"Origin: http://{host}\0.evil.example\r\n\r\n".encode()),
+        ("an Origin with a NUL inside", "400", ws + f"Origin: http://{host}\0.evil.example\r\n\r\n".encode()),
     ]
     problems = []
     for name, code, request in cases:
@@ -82,6 +84,50 @@ def head_refusals(port, token):
         if line.split(" ")[1:2] != [code]:
             problems.append(f"{name}: answered {line[:60]!r}, not {code}")
     return problems
+
+
+def rfc_answers(port, token):
+    """Close frames no client may send (codes 999, 1005 and 5000, a 1-byte body, a reason that is not
+    UTF-8) answered by the server's close 1002; a folded header line and a space before a header's
+    colon answered 400 (RFC 6455 §5.5.1, §7.4; RFC 7230 §3.2.4): each was once taken as it came."""
+    problems = []
+    bodies = [("close code 999", struct.pack(">H", 999)), ("close code 1005", struct.pack(">H", 1005)),
+              ("close code 5000", struct.pack(">H", 5000)), ("a 1-byte close body", b"\x03"),
+              ("a close reason not UTF-8", struct.pack(">H", 1000) + b"\xff\xfe")]
+    for name, body in bodies:
+        try:
+            sock = open_socket(port, token)
+            sock.sendall(frame(body, opcode=8))
+            code = close_answer(sock)
+            sock.close()
+        except OSError as error:
+            code = error
+        if code != 1002:
+            problems.append(f"{name}: the server's close answered {code}, not 1002")
+    host = f"127.0.0.1:{port}"
+    heads = [("a folded header line", f"GET /?token={token} HTTP/1.1\r\nHost: {host}\r\nX-A: a\r\n b\r\n\r\n"),
+             ("'Host : evil.example'", f"GET /?token={token} HTTP/1.1\r\nHost : evil.example\r\n\r\n")]
+    for name, request in heads:
+        line = ask(port, request.encode())
+        if line.split(" ")[1:2] != ["400"]:
+            problems.append(f"{name}: answered {line[:60]!r}, not 400")
+    return problems
+
+
+HIDDEN = "\u009b\u0085\u202e\u2066\u2069\u2028\u2029"  # C1 (CSI, NEL), bidi, line and paragraph separators
+
+
+def hidden_controls(port, token):
+    """A command named with C1, bidi and separator characters: its error line shows each as '?', as a
+    C0 control is (a U+009B reached the terminal as CSI; a U+202E reversed the rest of the line)."""
+    sock = open_socket(port, token)
+    sock.sendall(frame(json.dumps({"cmd": "a" + HIDDEN + "b"}, ensure_ascii=False).encode()))
+    got = read_messages(sock, time.monotonic() + 3, lambda got: any(m.get("type") == "error" for m in got))
+    sock.close()
+    errors = [m["text"] for m in got if m.get("type") == "error"]
+    if not errors or "'a" + "?" * len(HIDDEN) + "b'" not in errors[0] or any(c in errors[0] for c in HIDDEN):
+        return [f"C1 and bidi controls in a name: answered {errors!r}, not 'a{'?' * len(HIDDEN)}b'"]
+    return []
 
 
 def idle_sockets(port, token):
@@ -227,8 +273,8 @@ def stop_during_step(program, how, scratch, timeout=20, env=None, prefix=()):
 
 
 def check_hostile(program, scratch, start_seconds=20, bounded=True, env=None, prefix=()):
-    """Round 3's cases against `program --live` on a 16² curtain: names cut inside a UTF-8 character,
-    the request heads the server must refuse, 60 idle sockets, a ping flood beside an honest page; and,
+    """Rounds 3 and 4's cases against `program --live` on a 16² curtain: names cut inside a UTF-8 character,
+    the request heads the server must refuse, RFC answers, control characters in a name, 60 idle sockets, a ping flood beside an honest page; and,
     on two programs of their own at the same time, SIGINT and the page's stop during a 1e8-iteration
     step. Returns (problems, numbers), numbers["stderr"] the three programs' stderr. bounded=False (ASan):
     the flood's memory and rate are not asked; env, prefix: the programs' environment and the words
@@ -249,7 +295,7 @@ def check_hostile(program, scratch, start_seconds=20, bounded=True, env=None, pr
     problems, numbers = [], {}
     try:
         port, token = read_url(process, start_seconds)
-        for case in (cut_utf8_names, head_refusals, idle_sockets):
+        for case in (cut_utf8_names, head_refusals, rfc_answers, hidden_controls, idle_sockets):
             problems += case(port, token)
             if process.poll() is not None:
                 problems.append(f"the program ended (exit {process.returncode}) at the case {case.__name__}")
@@ -270,6 +316,8 @@ def check_hostile(program, scratch, start_seconds=20, bounded=True, env=None, pr
     for thread in stoppers:
         thread.join(timeout=30)
     numbers["stderr"] = err
+    if any(c in err for c in HIDDEN):
+        problems.append("C1 or bidi controls reached stderr as themselves, not as '?'")
     for how in ("SIGINT", "stop"):
         stop_problems, numbers[f"{how}_seconds"], stop_err = stops.get(how, ([f"{how}: did not finish"], None, ""))
         problems += stop_problems

@@ -289,8 +289,8 @@ def run_live(nice=False):
                                           prefix=["nice", "-n", "10"] if nice else [])
     report = grade.sanitizer_report(numbers.get("stderr", ""), ROOT)
     ok = not problems and not report
-    return (name, ok, f"names cut inside a character, refused heads, {IDLE_SOCKETS} idle sockets, a ping flood, "
-                      f"SIGINT and stop during a 1e8-iteration step ({time.monotonic() - start:.1f} s)",
+    return (name, ok, f"names cut inside a character, refused heads, RFC answers, hidden controls, {IDLE_SOCKETS} idle "
+                      f"sockets, a ping flood, SIGINT and stop during a 1e8-iteration step ({time.monotonic() - start:.1f} s)",
             report + problems)
 
 
