@@ -20,7 +20,7 @@
 #include <catch2/matchers/catch_matchers_string.hpp>
 using Catch::Approx;
 #else
-#include "tests/support/catch.h"
+#include <catch2/catch.hpp>
 #endif
 
 // Ends the running case as skipped, saying why: Catch2 3.3's SKIP; where there
@@ -44,7 +44,7 @@ inline auto ContainsText(const std::string& text) {
 #if CL_CATCH2_MAJOR >= 3
   return Catch::Matchers::ContainsSubstring(text);
 #else
-  return cl::test::ContainsText(text);
+  return Catch::Matchers::Contains(text);
 #endif
 }
 
