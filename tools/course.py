@@ -15,6 +15,7 @@ from cl.demo import cmd_demo, cmd_run
 from cl.fuzz import cmd_fuzz
 from cl.grading import cmd_grade
 from cl.handouts import cmd_handouts
+from cl.lanes import cmd_lanes
 from cl.live import cmd_live
 from cl.measure import cmd_bench, cmd_extremes
 from cl.mistakes import cmd_mistakes
@@ -57,13 +58,17 @@ usage: ./course COMMAND [ARGS]
                                      each planted: the grader must catch it (instructor)
   fuzz [SECONDS]                     fuzz the scene loader with libFuzzer (clang; default 60 s)
   sanitize                           the whole test suite under AddressSanitizer and UBSan (build-asan)
+  lanes [libcxx] [mingw]             the course built with clang + libc++ (macOS's toolchain) and
+                                     MinGW-w64 (Windows'), its references graded there (Wine for
+                                     Windows) -> build/lanes/ (CI, after ./course test)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
 
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
-            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live}
+            "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live,
+            "lanes": cmd_lanes}
 
 
 def main(argv):
