@@ -38,6 +38,7 @@ bool set_blas_threads(int threads) {
 #endif
 }
 
+#ifdef CL_HAVE_CHOLMOD  // only CHOLMOD's factorization calls it (without, it would warn)
 namespace {
 // The first CHOLMOD factorization of a process whose program chose no BLAS
 // threads (and whose environment names none) makes the BLAS serial: see
@@ -50,6 +51,7 @@ void default_blas_threads() {
   set_blas_threads(1);
 }
 }  // namespace
+#endif
 
 MovableMap make_movable_map(const Eigen::VectorXd& inv_mass) {
   MovableMap map;

@@ -19,6 +19,7 @@ from cl.demo import cmd_demo, cmd_run
 from cl.fuzz import cmd_fuzz
 from cl.grading import cmd_grade
 from cl.handouts import cmd_handouts
+from cl.lanes import cmd_lanes
 from cl.live import cmd_live
 from cl.measure import cmd_bench, cmd_extremes
 from cl.mistakes import cmd_mistakes
@@ -69,6 +70,9 @@ usage: ./course COMMAND [ARGS]
   setup [--all]                      install what the student's commands need (Debian and Ubuntu
                                      as root), or print the one line that does; --all: the
                                      instructor's too (what ./course test needs)
+  lanes [libcxx] [mingw]             the course built with clang + libc++ (macOS's toolchain) and
+                                     MinGW-w64 (Windows'), its references graded there (Wine for
+                                     Windows) -> build/lanes/ (CI, after ./course test)
   help                               this text
 
 Paths are relative to the course root; CL_BUILD_DIR overrides build/."""
@@ -91,7 +95,7 @@ def cmd_setup(argv):
 COMMANDS = {"demo": cmd_demo, "test": cmd_test, "grade": cmd_grade, "run": cmd_run,
             "plots": cmd_plots, "bench": cmd_bench, "extremes": cmd_extremes, "fuzz": cmd_fuzz, "sanitize": cmd_sanitize,
             "release": cmd_release, "handouts": cmd_handouts, "claims": cmd_claims, "mistakes": cmd_mistakes, "autograder": cmd_autograder, "view": cmd_view, "live": cmd_live,
-            "setup": cmd_setup}
+            "setup": cmd_setup, "lanes": cmd_lanes}
 
 
 def main(argv):

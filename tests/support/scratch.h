@@ -11,14 +11,26 @@
 #include <string>
 #include <system_error>
 
-#include <unistd.h>
+#ifdef _WIN32
+#include <process.h>  // _getpid
+#else
+#include <unistd.h>  // getpid
+#endif
 
 namespace cl::test {
+
+inline long process_id() {
+#ifdef _WIN32
+  return static_cast<long>(::_getpid());
+#else
+  return static_cast<long>(::getpid());
+#endif
+}
 
 class ScratchDir {
  public:
   explicit ScratchDir(const std::string& name)
-      : path_(std::filesystem::temp_directory_path() / ("cl_test_" + name + "_" + std::to_string(::getpid()))) {
+      : path_(std::filesystem::temp_directory_path() / ("cl_test_" + name + "_" + std::to_string(process_id()))) {
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }

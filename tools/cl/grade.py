@@ -7,6 +7,7 @@ import fnmatch
 import json
 import os
 import re
+import shlex
 import signal
 import subprocess
 import tempfile
@@ -25,8 +26,12 @@ HIDDEN_TAG = "[hidden]"
 FAILURE_TAGS = ("Expression", "Exception", "FatalErrorCondition", "Failure")
 # OpenMP threads that wait sleep instead of spinning: on a shared or busy
 # machine a spinning barrier costs a tiny parallel sweep milliseconds, and
-# 10,000 sweeps then hit the time limit. Results are the same bits.
-CASE_ENV = {**os.environ, "OMP_WAIT_POLICY": os.environ.get("OMP_WAIT_POLICY", "passive")}
+# 10,000 sweeps then hit the time limit. Results are the same bits. Read at
+# each case, so that what a caller sets (the lanes: Wine's prefix) is passed on.
+def case_env():
+    return {**os.environ, "OMP_WAIT_POLICY": os.environ.get("OMP_WAIT_POLICY", "passive")}
+
+
 TERMINAL_CAP = 300  # characters of one failure's reason, and of its context, on the terminal
 JSON_CAP = 4000  # characters of one case's output in results.json
 
@@ -88,6 +93,14 @@ def lab_id(lab):
 def lab_tag(lab):
     """`lab01_single_spring` -> `[lab01]`, the tag of its graded cases."""
     return f"[{lab_id(lab)}]"
+
+
+def test_runner():
+    """The command a test program runs under, from CL_TEST_RUNNER (split as a
+    shell would; [] when unset): every listing and every case is then
+    `RUNNER... BINARY ARGS`. The MinGW lane sets `wine` to grade a Windows
+    build on Linux (tools/cl/lanes.py)."""
+    return shlex.split(os.environ.get("CL_TEST_RUNNER", ""))
 
 
 class ListingError(Exception):
@@ -170,7 +183,7 @@ def catch_list(binary, *args, stderr=False):
     """Output lines of a Catch2 listing (its exit code is a count, not a status);
     stderr: its stderr's lines too."""
     try:
-        done = subprocess.run([str(binary), *args], capture_output=True, encoding="utf-8", errors="replace",
+        done = subprocess.run([*test_runner(), str(binary), *args], capture_output=True, encoding="utf-8", errors="replace",
                               timeout=LIST_TIMEOUT, check=False)
     except subprocess.TimeoutExpired:
         raise ListingError(f"listing timed out after {LIST_TIMEOUT} s") from None
@@ -232,9 +245,10 @@ def run_case(binary, name, points, work, root):
     report = work / "report.xml"
     report.unlink(missing_ok=True)
     try:
-        # -o relative to the cwd: an absolute one failed under Wine (a Windows
-        # program given a POSIX path); a relative one is the same on every system.
-        done = subprocess.run([str(binary), name, "-r", "xml", "-o", report.name], cwd=work, env=CASE_ENV,
+        # -o relative to the cwd: a program run through a runner may not read
+        # the host's absolute path as one of its own (Wine: a Windows path).
+        done = subprocess.run([*test_runner(), str(binary), name, "-r", "xml", "-o", report.name], cwd=work,
+                              env=case_env(),
                               capture_output=True, timeout=CASE_TIMEOUT, check=False)
     except subprocess.TimeoutExpired:
         return CaseResult(name, points, False, f"timed out after {CASE_TIMEOUT} s")

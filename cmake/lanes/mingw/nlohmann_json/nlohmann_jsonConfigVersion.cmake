@@ -1,0 +1,5 @@
+# The version of the headers staged: Debian's own version file (plain CMake).
+include(/usr/share/cmake/nlohmann_json/nlohmann_jsonConfigVersion.cmake OPTIONAL RESULT_VARIABLE _cl_found)
+if(NOT _cl_found)
+  set(PACKAGE_VERSION_UNSUITABLE TRUE)
+endif()
