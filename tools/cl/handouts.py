@@ -373,15 +373,22 @@ def needed_targets(labs):
     return targets + ["trade", "extremes"]
 
 
+# The pages outside the labs whose commands a reader copies: the README and the
+# pages it sends readers to (DESIGN.md's usage lines are its contracts, not commands).
+FRONT_PAGES = [ROOT / "README.md", ROOT / "docs" / "views.md", ROOT / "docs" / "instructor.md",
+               ROOT / "docs" / "testing.md"]
+
+
 def check_handouts(labs):
-    """One PageResult per lab's handout (and the README's, with every lab)."""
+    """One PageResult per lab's handout (and, with every lab, the README's and
+    its docs pages', FRONT_PAGES)."""
     results = [check_page(ROOT / "labs" / lab / "README.md", lab_number(lab)) for lab in labs]
     for lab, result in zip(labs, results):  # and its point totals, as one more check
         result.checked += 1
         result.problems += [f"points: {problem}" for problem in
                             points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
     if set(labs) == set(lab_dirs()):
-        results.append(check_page(ROOT / "README.md", 0))
+        results += [check_page(page, 0) for page in FRONT_PAGES]
     return results
 
 
@@ -389,7 +396,7 @@ def cmd_handouts(argv):
     parser = argparse.ArgumentParser(prog="course handouts",
                                      description="check that every command of each lab's handout runs in "
                                                  "its week's tree (by --check; nothing is written)")
-    parser.add_argument("labs", nargs="*", metavar="labNN", help="the labs (default: all, and README.md)")
+    parser.add_argument("labs", nargs="*", metavar="labNN", help="the labs (default: all, README.md and the docs pages it links)")
     args = parser.parse_args(argv)
     labs = [resolve_lab(token) for token in args.labs] or lab_dirs()
     if is_release():
