@@ -290,7 +290,7 @@ struct SpdFactorization::Cholmod {
       }
     };
     each_lower([&](int, int column, int) { ++permuted_outer[static_cast<std::size_t>(column) + 1]; });
-    for (int j = 0; j < n; ++j) permuted_outer[j + 1] += permuted_outer[j];
+    for (std::size_t j = 0; j + 1 < permuted_outer.size(); ++j) permuted_outer[j + 1] += permuted_outer[j];
     const auto entries = static_cast<std::size_t>(permuted_outer.back());
     permuted_inner.resize(entries);
     source.resize(entries);
@@ -302,7 +302,8 @@ struct SpdFactorization::Cholmod {
     });
     std::vector<std::pair<int, int>> column;
     for (int j = 0; j < n; ++j) {
-      const auto begin = static_cast<std::size_t>(permuted_outer[j]), end = static_cast<std::size_t>(permuted_outer[j + 1]);
+      const auto at = static_cast<std::size_t>(j);
+      const auto begin = static_cast<std::size_t>(permuted_outer[at]), end = static_cast<std::size_t>(permuted_outer[at + 1]);
       column.clear();
       for (std::size_t k = begin; k < end; ++k) column.emplace_back(permuted_inner[k], source[k]);
       std::sort(column.begin(), column.end());

@@ -51,14 +51,15 @@ std::vector<std::uint8_t> read_bytes(const std::string& path) {
 // Frame k of the file as the view decodes it: x = box_min + q · step.
 Eigen::Matrix3Xd decoded_positions(const nlohmann::json& header, const std::vector<std::uint8_t>& data, int k) {
   const int n = header["particles"];
-  const nlohmann::json& frame = header["frames"][k];
+  const nlohmann::json& frame = header["frames"][static_cast<std::size_t>(k)];
   const std::size_t start = static_cast<std::size_t>(k) * header["frame_bytes"].get<std::size_t>();
   Eigen::Matrix3Xd x(3, n);
   for (int p = 0; p < n; ++p) {
     for (int a = 0; a < 3; ++a) {
       const std::size_t at = start + 2 * static_cast<std::size_t>(3 * p + a);
       const int q = data[at] | (data[at + 1] << 8);
-      x(a, p) = frame["box_min"][a].get<double>() + q * frame["step"][a].get<double>();
+      const auto axis = static_cast<std::size_t>(a);
+      x(a, p) = frame["box_min"][axis].get<double>() + q * frame["step"][axis].get<double>();
     }
   }
   return x;
@@ -68,7 +69,7 @@ double decoded_strain(const nlohmann::json& header, const std::vector<std::uint8
   const std::size_t start = static_cast<std::size_t>(k) * header["frame_bytes"].get<std::size_t>() +
                             6 * header["particles"].get<std::size_t>() + static_cast<std::size_t>(spring);
   const auto q = static_cast<std::int8_t>(data[start]);
-  return q * header["frames"][k]["strain_scale"].get<double>() / 127.0;
+  return q * header["frames"][static_cast<std::size_t>(k)]["strain_scale"].get<double>() / 127.0;
 }
 
 }  // namespace
@@ -110,16 +111,17 @@ TEST_CASE("a trajectory reads back to the stated quantisation, with its topology
   CHECK(stated <= 1e-4);  // the issue's bound: 0.1 mm on a 3 m scene
   for (int k = 0; k < 4; ++k) {
     CAPTURE(k);
-    CHECK(header["frames"][k]["frame"] == k);
-    CHECK(header["frames"][k]["time"].get<double>() == Approx(k / 60.0));
-    CHECK(header["frames"][k]["energy"].get<double>() == 10.0 - k);
+    const nlohmann::json& frame = header["frames"][static_cast<std::size_t>(k)];
+    CHECK(frame["frame"] == k);
+    CHECK(frame["time"].get<double>() == Approx(k / 60.0));
+    CHECK(frame["energy"].get<double>() == 10.0 - k);
     const Eigen::Matrix3Xd decoded = decoded_positions(header, data, k);
     const double error = (decoded - written[static_cast<std::size_t>(k)]).cwiseAbs().maxCoeff();
     CAPTURE(error, stated);
     CHECK(error <= stated * (1 + 1e-9));
-    const double scale = header["frames"][k]["strain_scale"];
+    const double scale = frame["strain_scale"];
     for (int e = 0; e < 2; ++e) {
-      const double exact = cl::signed_strain(written[static_cast<std::size_t>(k)], scene.springs[e]);
+      const double exact = cl::signed_strain(written[static_cast<std::size_t>(k)], scene.springs[static_cast<std::size_t>(e)]);
       CAPTURE(e, exact, scale);
       CHECK(std::abs(decoded_strain(header, data, k, e) - exact) <= scale / 254 * (1 + 1e-9));
     }

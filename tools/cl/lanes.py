@@ -18,7 +18,6 @@ time; the lines before it say what failed.
 import argparse
 import json
 import os
-import resource
 import shutil
 import subprocess
 import time
@@ -39,6 +38,7 @@ CONFIGURE = {"libcxx": ["-DCL_CATCH2_2=ON"], "mingw": []}
 # The labs graded under Wine: every lab's references, each case a Wine
 # process of about a second.
 WINE_LABS = "all"
+WARNINGS_SHOWN = 5
 NO_OPENMP = "this build has no OpenMP, so there is no parallel region to count"
 
 
@@ -85,8 +85,8 @@ def install(lanes):
 
 def children_cpu():
     """CPU seconds (user + system) of the child processes waited for so far."""
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
+    times = os.times()  # not the resource module: ./course imports this one on Windows too
+    return times.children_user + times.children_system
 
 
 def run_quiet(command, **kwargs):
@@ -146,7 +146,9 @@ def build(targets, build_dir):
     if code != 0:
         failed = sorted({line.split()[-1] for line in output.splitlines() if line.startswith("FAILED: ")})
         raise LaneFailure(f"build failed ({len(failed)} outputs)", [*failed[:6], *first_errors(output)])
-    return output.count(" warning: ")
+    # The tree's own warnings, each once (a header's, from every file that includes it).
+    return list(dict.fromkeys(line.replace(str(ROOT) + "/", "") for line in output.splitlines()
+                              if " warning: " in line and "/usr/" not in line.split(" warning: ")[0]))
 
 
 def grade_references(build_dir, labs, runner=None):
@@ -206,7 +208,9 @@ def run_lane(lane):
     warnings = build(targets_of(lane, build_dir), build_dir)
     built = f"built in {time.monotonic() - start:.0f} s"
     if warnings:
-        built += f" ({warnings} warnings)"
+        built += f" ({len(warnings)} warnings, the first {min(len(warnings), WARNINGS_SHOWN)} above)"
+        for line in warnings[:WARNINGS_SHOWN]:
+            print(f"        {line}")
     if lane == "libcxx":
         passed, counted, skipped, lines = grade_references(build_dir, labs)
         unit_passed, unit_total, unit_lines = unit_tests(build_dir)
