@@ -19,7 +19,7 @@ import time
 import urllib.request
 from pathlib import Path
 
-from .live_stress import PAGE_SECONDS, close_answer, frame, open_socket, read_messages, rss
+from .live_stress import PAGE_SECONDS, close_answer, frame, honest_frame, open_socket, read_messages, rss
 
 # Each case below is named by what it sends; each broke the server before the fix it checks.
 
@@ -193,16 +193,7 @@ def ping_flood(port, token, pid, bounded=True):
         while time.monotonic() - start < PING_SECONDS:
             if time.monotonic() >= next_sample:
                 peak, next_sample = max(peak, rss(pid)), next_sample + 0.1
-            honest.settimeout(0.05)
-            try:
-                message = honest.recv()
-            except websocket.WebSocketTimeoutException:
-                continue
-            if isinstance(message, bytes):
-                at = int(time.monotonic() - start)
-                if at < len(bins):
-                    bins[at] += 1
-                honest.send('{"cmd": "ack"}')
+            honest_frame(honest, start, bins, 0.05)
     except (OSError, websocket.WebSocketException) as error:
         problems.append(f"ping flood: the honest page lost its connection: {error}")
     peak = max(peak, rss(pid))

@@ -24,7 +24,7 @@ import statistics
 import subprocess
 import time
 
-from .live_stress import open_socket, rss
+from .live_stress import honest_frame, open_socket, rss
 
 TINY_SOCKETS = 15
 TINY_SECONDS = 3.0
@@ -99,21 +99,11 @@ class Honest:
 
     def frames(self, seconds):
         """Frames per 1-s bin for `seconds`; the server's peak memory sampled every 0.1 s."""
-        import websocket
         bins, start, next_sample = [0] * int(round(seconds)), time.monotonic(), 0.0
         while time.monotonic() - start < seconds:
             if time.monotonic() - start >= next_sample:
                 self.peak_rss, next_sample = max(self.peak_rss, rss(self.pid)), next_sample + 0.1
-            self.client.settimeout(0.05)
-            try:
-                message = self.client.recv()
-            except websocket.WebSocketTimeoutException:
-                continue
-            if isinstance(message, bytes):
-                at = int(time.monotonic() - start)
-                if at < len(bins):
-                    bins[at] += 1
-                self.client.send('{"cmd": "ack"}')
+            honest_frame(self.client, start, bins, 0.05)
         return bins
 
 

@@ -127,6 +127,25 @@ def rss(pid):
     return 0
 
 
+def honest_frame(client, start, bins, timeout):
+    """One message from an honest page's socket within `timeout` (None: none
+    came): a frame is counted in its second's bin since `start` and acknowledged,
+    as the page does."""
+    import websocket  # Debian's python3-websocket
+
+    client.settimeout(timeout)
+    try:
+        message = client.recv()
+    except websocket.WebSocketTimeoutException:
+        return None
+    if isinstance(message, bytes):
+        at = int(time.monotonic() - start)
+        if at < len(bins):
+            bins[at] += 1
+        client.send('{"cmd": "ack"}')
+    return message
+
+
 class Stress:
     def __init__(self, port, token, pid):
         self.port, self.token, self.pid = int(port), token, pid
@@ -237,17 +256,8 @@ class Stress:
                 if time.monotonic() >= next_ask and time.monotonic() - start < SECONDS:
                     client.send(json.dumps({"cmd": "honest-mistake", "n": asked}))
                     asked, next_ask = asked + 1, next_ask + 0.5
-                client.settimeout(0.1)
-                try:
-                    message = client.recv()
-                except websocket.WebSocketTimeoutException:
-                    continue
-                if isinstance(message, bytes):
-                    at = int(time.monotonic() - start)
-                    if at < len(bins):
-                        bins[at] += 1
-                    client.send('{"cmd": "ack"}')
-                elif json.loads(message).get("type") == "error":
+                message = honest_frame(client, start, bins, 0.1)
+                if isinstance(message, str) and json.loads(message).get("type") == "error":
                     answered += 1
         except (OSError, websocket.WebSocketException) as error:
             self.problem(f"the honest client lost its connection: {error}")
