@@ -144,23 +144,9 @@ function(add_lab name)
   # Link lines: [support, implementation] for this lab, then for each earlier
   # lab: the tests' (closure) and the executables' (driver_closure).
   _cl_link_chains(${name} "${closure}" reference_chain isolated_chain student_tested)
-  set(links_json "")
-  foreach(dep IN LISTS closure)
-    if(dep IN_LIST student_tested)
-      list(APPEND links_json "\"${dep}\": \"student\"")
-    else()
-      list(APPEND links_json "\"${dep}\": \"reference\"")
-    endif()
-  endforeach()
+  _cl_links_json(links_json "${closure}" "${student_tested}")
   _cl_link_chains(${name} "${driver_closure}" driver_reference_chain driver_isolated_chain student_earlier)
-  set(program_links_json "")
-  foreach(dep IN LISTS driver_closure)
-    if(dep IN_LIST student_earlier)
-      list(APPEND program_links_json "\"${dep}\": \"student\"")
-    else()
-      list(APPEND program_links_json "\"${dep}\": \"reference\"")
-    endif()
-  endforeach()
+  _cl_links_json(program_links_json "${driver_closure}" "${student_earlier}")
   # A lab with a reference can only have earlier labs with references (a
   # release ships the past ones, the full tree all of them).
   foreach(dep IN LISTS driver_closure)
@@ -346,6 +332,20 @@ extern "C" const char cl_student_earlier_labs[] = "@student_earlier@";
 ]=] text @ONLY)
   file(CONFIGURE OUTPUT "${path}" CONTENT "${text}" @ONLY)
   set(${out} "${path}" PARENT_SCOPE)
+endfunction()
+
+# Sets `out` to labs.json's list of `deps`, each "student" when it is in
+# `student` (the earlier labs linked as the student's code), else "reference".
+function(_cl_links_json out deps student)
+  set(entries "")
+  foreach(dep IN LISTS deps)
+    if(dep IN_LIST student)
+      list(APPEND entries "\"${dep}\": \"student\"")
+    else()
+      list(APPEND entries "\"${dep}\": \"reference\"")
+    endif()
+  endforeach()
+  set(${out} "${entries}" PARENT_SCOPE)
 endfunction()
 
 # Called once the whole CMakeLists.txt is read (cmake_language DEFER): labs.json,
