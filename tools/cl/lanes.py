@@ -56,8 +56,8 @@ def missing_packages(lanes):
         return None
     missing = []
     for package in dict.fromkeys(p for lane in lanes for p in PACKAGES[lane]):
-        done = subprocess.run(["dpkg-query", "-W", "-f=${Status}", package], capture_output=True, text=True,
-                              check=False)
+        done = subprocess.run(["dpkg-query", "-W", "-f=${Status}", package], capture_output=True,
+                              encoding="utf-8", errors="replace", check=False)
         if done.stdout != "install ok installed":
             missing.append(package)
     return missing
@@ -91,7 +91,7 @@ def children_cpu():
 
 def run_quiet(command, **kwargs):
     """Run `command`, its output captured: (exit code, output)."""
-    done = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+    done = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, encoding="utf-8",
                           errors="replace", check=False, **kwargs)
     return done.returncode, done.stdout
 
