@@ -407,7 +407,9 @@ SANITIZER_HINTS = [
     (("null pointer", "SEGV on unknown address 0x0000"), " (a matrix or vector written before it was sized?)"),
     (("heap-buffer-overflow", "out of bounds", "stack-buffer-overflow"), " (an index past the end?)"),
 ]
-FRAME = re.compile(r"#\d+ 0x[0-9a-f]+ in (.*?) (/\S+?):(\d+)(?::\d+)?$")
+# A frame's file is absolute, or relative to the build tree where the compiler
+# ran when ccache rewrote the paths under CCACHE_BASEDIR (GCC 14 keeps them so).
+FRAME = re.compile(r"#\d+ 0x[0-9a-f]+ in (.*?) ((?:/|\.\./|\./)\S+?):(\d+)(?::\d+)?$")
 
 
 def sanitizer_report(text, root):
@@ -421,13 +423,13 @@ def sanitizer_report(text, root):
             if match and headline is None:
                 headline = form.format(*match.groups())
                 headline = re.sub(r" on (unknown )?address 0x[0-9a-f]+.*", r"", headline)
-                if pattern is UBSAN_ERROR and inside(match.group(1), root):
-                    return [f"{headline} at {relative(match.group(1), root)}:{match.group(2)}"]
+                if pattern is UBSAN_ERROR and inside(in_tree(match.group(1), root), root):
+                    return [f"{headline} at {relative(in_tree(match.group(1), root), root)}:{match.group(2)}"]
     frames = []
     for line in text.splitlines():
         match = FRAME.search(line.strip())
-        if match and inside(match.group(2), root):
-            frames.append((relative(match.group(2), root), match.group(3), match.group(1)))
+        if match and inside(in_tree(match.group(2), root), root):
+            frames.append((relative(in_tree(match.group(2), root), root), match.group(3), match.group(1)))
     if headline is None and not frames:
         return []
     hint = next((h for words, h in SANITIZER_HINTS if headline and any(w in headline for w in words)), "")
@@ -437,6 +439,15 @@ def sanitizer_report(text, root):
         function = re.sub(r"\(.*", "", frame[2])
         lines.append(f"at {frame[0]}:{frame[1]} (in {function})")
     return lines
+
+
+def in_tree(path, root):
+    """A sanitizer's file name as a path: a relative one is relative to the build
+    tree the compiler ran in (CL_BUILD_DIR, default build/ of `root`)."""
+    if os.path.isabs(path):
+        return path
+    build = Path(os.environ.get("CL_BUILD_DIR", "build"))
+    return os.path.normpath((build if build.is_absolute() else Path(root) / build) / path)
 
 
 def inside(path, root):
