@@ -223,6 +223,18 @@ void BM_XpbdStep(benchmark::State& state) { xpbd<false>(state); }
 void BM_XpbdStepCalling(benchmark::State& state) { xpbd<true>(state); }
 #endif
 
+// Whether a run ended in an error or was skipped: Google Benchmark 1.7
+// (Debian 12) says so in `error_occurred`, 1.8 and later (Debian 13, Homebrew)
+// in `skipped`, which replaced it.
+template <typename Run>
+auto run_failed(const Run& run, int) -> decltype(static_cast<bool>(run.error_occurred)) {
+  return run.error_occurred;
+}
+template <typename Run>
+bool run_failed(const Run& run, long) {
+  return static_cast<bool>(run.skipped);
+}
+
 // Remembers each run's CPU time per iteration for the summary: the median
 // aggregate when the runs were repeated, else the median of the runs. It
 // prints as the library's own reporter does: in colour on a terminal only, so
@@ -233,7 +245,7 @@ class Collector : public benchmark::ConsoleReporter {
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& run : runs) {
-      if (run.error_occurred) continue;
+      if (run_failed(run, 0)) continue;
       const bool median = run.run_type == Run::RT_Aggregate && run.aggregate_name == "median";
       if (run.run_type == Run::RT_Aggregate && !median) continue;
       Entry& entry = entries_[run.run_name.str()];
