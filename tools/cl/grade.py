@@ -423,13 +423,13 @@ def sanitizer_report(text, root):
             if match and headline is None:
                 headline = form.format(*match.groups())
                 headline = re.sub(r" on (unknown )?address 0x[0-9a-f]+.*", r"", headline)
-                if pattern is UBSAN_ERROR and inside(in_tree(match.group(1), root), root):
-                    return [f"{headline} at {relative(in_tree(match.group(1), root), root)}:{match.group(2)}"]
+                if pattern is UBSAN_ERROR and inside(path := in_tree(match.group(1), root), root):
+                    return [f"{headline} at {relative(path, root)}:{match.group(2)}"]
     frames = []
     for line in text.splitlines():
         match = FRAME.search(line.strip())
-        if match and inside(in_tree(match.group(2), root), root):
-            frames.append((relative(in_tree(match.group(2), root), root), match.group(3), match.group(1)))
+        if match and inside(path := in_tree(match.group(2), root), root):
+            frames.append((relative(path, root), match.group(3), match.group(1)))
     if headline is None and not frames:
         return []
     hint = next((h for words, h in SANITIZER_HINTS if headline and any(w in headline for w in words)), "")
