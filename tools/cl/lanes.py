@@ -225,16 +225,20 @@ def run_lane(lane):
     saved = {key: os.environ.get(key) for key in WINE_VARIABLES}
     os.environ.update({key: env[key] for key in WINE_VARIABLES})
     try:
-        # The first run makes the prefix; then one wineserver for the whole
-        # lane (-p: it stays between the cases' processes), stopped at the end.
-        run_quiet(["wine", "cmd", "/c", "exit"], env=env, timeout=600)
-        subprocess.run(["wineserver", "-p"], env=env, check=False)
-        # One test program started once before the grader's timed listings:
-        # Wine's first start of a program (its DLLs loaded, the registry read)
-        # took over the listing's 60 s on a loaded machine (CI3, 2026-12-07).
-        first = next(iter(sorted((build_dir / "bin").glob("*_tests_solution.exe"))), None)
-        if first is not None:
-            run_quiet(["wine", str(first), "--help"], env=env, timeout=600)
+        # The first run makes the prefix. Then one wineserver for the whole
+        # lane (-p: it stays between the cases' processes), stopped at the end,
+        # and Wine's background services (winedevice.exe and the like) started
+        # under it with their output on /dev/null: a service inherits the
+        # standard handles of the program whose start launched it, and one
+        # launched by a graded program whose output the grader reads holds
+        # that pipe open as long as the persistent server lives, so the read
+        # never ends (CI, 2026-12-07: the lane's first captured run hung for
+        # its whole timeout; reproduced with `wine prog 2>&1 | cat`).
+        quiet = dict(env=env, cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                     stderr=subprocess.DEVNULL, check=False)
+        subprocess.run(["wine", "cmd", "/c", "exit"], timeout=600, **quiet)
+        subprocess.run(["wineserver", "-p"], **quiet)
+        subprocess.run(["wine", "cmd", "/c", "exit"], timeout=600, **quiet)
         passed, counted, skipped, lines = grade_references(build_dir, graded, runner="wine")
     finally:
         subprocess.run(["wineserver", "-k"], env=env, check=False)
