@@ -236,8 +236,13 @@ def run_lane(lane):
         # its whole timeout; reproduced with `wine prog 2>&1 | cat`).
         quiet = dict(env=env, cwd=ROOT, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                      stderr=subprocess.DEVNULL, check=False)
+        # `wineserver -p` while the first run's server lingers fails (exit 2)
+        # and leaves none persistent: every graded program then boots Wine's
+        # services again, seconds each. So: wait for that server to end first.
         subprocess.run(["wine", "cmd", "/c", "exit"], timeout=600, **quiet)
-        subprocess.run(["wineserver", "-p"], **quiet)
+        subprocess.run(["wineserver", "-w"], timeout=600, **quiet)
+        if subprocess.run(["wineserver", "-p"], timeout=60, **quiet).returncode != 0:
+            raise LaneFailure("wineserver -p did not start a persistent Wine server", [])
         subprocess.run(["wine", "cmd", "/c", "exit"], timeout=600, **quiet)
         passed, counted, skipped, lines = grade_references(build_dir, graded, runner="wine")
     finally:
