@@ -15,7 +15,7 @@ import time
 from . import grade
 from .base import BUILD, CONFIG, ROOT, CourseError, program
 from .labs import manifest, manifest_stale
-from .requirements import cmake_hints
+from .requirements import INSTALLED_STAMP, cmake_hints
 
 ERROR_LINES = 14  # of a failed build, shown
 WARNING_LINES = 3  # of the warnings in a student's files, shown
@@ -46,9 +46,18 @@ def uses_ninja(build_dir):
     return cache.is_file() and "CMAKE_GENERATOR:INTERNAL=Ninja\n" in cache.read_text(encoding="utf-8")
 
 
+def installed_since_configure(build_dir):
+    """True when ./course installed packages after build_dir was configured
+    (requirements.INSTALLED_STAMP): its cache still holds what was missing
+    then, and Ninja re-runs CMake only when a CMakeLists.txt changes."""
+    stamp, cache = build_dir / INSTALLED_STAMP, build_dir / "CMakeCache.txt"
+    return stamp.is_file() and cache.is_file() and stamp.stat().st_mtime >= cache.stat().st_mtime
+
+
 def configure(log=sys.stdout, force=False):
-    """Configure BUILD when it is new or its lab manifest is out of date."""
-    if force or not (BUILD / "CMakeCache.txt").is_file() or manifest_stale():
+    """Configure BUILD when it is new, its lab manifest is out of date, or
+    packages were installed since."""
+    if force or not (BUILD / "CMakeCache.txt").is_file() or manifest_stale() or installed_since_configure(BUILD):
         print("configuring...", end=" ", file=log, flush=True)
         start = time.monotonic()
         try:

@@ -11,6 +11,7 @@ from .build import BuildFailure, build_targets, configure
 from . import grade
 from .labs import executable, manifest
 from .plots import plots_failed, run_plots
+from .requirements import shown
 
 MEASUREMENT_PLOTS = {"trade": ("bench_pareto.py", "bench_scaling.py"), "extremes": ("bench_extremes.py",)}
 
@@ -141,6 +142,13 @@ def check_micro(checks):
     in ./course bench --micro, never in a test)."""
     targets = micro_targets()
     if not targets:
+        # ./course test needs Google Benchmark (requirements.py): a build
+        # without its programs is a failure, never a check that went missing
+        # (a fresh Debian 12 root, 2026-12-07: configured by ./course demo
+        # before ./course test installed the library, the tree never saw it).
+        checks.record(False, "Google Benchmark programs: none in this build (bench/bench_*.cpp are built where "
+                      "the configure finds a Google Benchmark that links: see benchmark_DIR and "
+                      f"CL_BENCHMARK_LINKS in {shown(BUILD / 'CMakeCache.txt')})")
         return
     with checks.timed("measurements: Google Benchmark programs, one short pass"):
         try:

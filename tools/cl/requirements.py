@@ -319,6 +319,9 @@ def shown(path):
     return path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
 
 
+INSTALLED_STAMP = "packages-installed"  # in the build tree: when ./course last installed packages
+
+
 def install(needs, system, log_path, recommends=True):
     """apt-get install the packages of `needs` (root on Debian); False when apt failed."""
     names = apt_names(needs, system)
@@ -345,6 +348,10 @@ def ensure(command, system=None, log_path=None, recommends=True):
         log_path = log_path or ROOT / os.environ.get("CL_BUILD_DIR", "build") / "apt.log"
         if not install(required + optional, system, log_path, recommends):
             return 1, f"course {command}: apt-get failed, see {shown(log_path)}"
+        # A tree configured before this install cached what it did not find
+        # (Google Benchmark, Boost): the stamp makes the next build configure
+        # again (build.configure), so nothing installed now stays unused.
+        (log_path.parent / INSTALLED_STAMP).touch()
         system.found.clear()
         importlib.invalidate_caches()  # python3-matplotlib and the like, just installed for this Python
         required, _ = missing(command, system)
