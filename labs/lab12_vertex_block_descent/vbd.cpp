@@ -50,9 +50,10 @@ std::vector<int> colour_particles(int particles, const std::vector<Spring>& spri
   not_implemented("colour_particles", __FILE__);
 }
 
-// TODO(lab12.5) [3 pts] One sweep: groups in order, the particles of a group
+// TODO(lab12.5) [4 pts] One sweep: groups in order, the particles of a group
 // in an OpenMP parallel for, each x_p += vertex_update(problem, adjacency, x, y, p).
-// Graded by tests/lab12_vertex_block_descent/test_sweep.cpp (3 pts).
+// Graded by tests/lab12_vertex_block_descent/test_sweep.cpp (3 pts) and
+// test_parallel.cpp (1 pt: the colours run in OpenMP parallel regions).
 void vbd_sweep(const lab06::Problem& problem, const Adjacency& adjacency, const std::vector<std::vector<int>>& groups,
                const Eigen::Matrix3Xd& y, Eigen::Matrix3Xd& x) {
   (void)problem, (void)adjacency, (void)groups, (void)y, (void)x;

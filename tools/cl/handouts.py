@@ -341,6 +341,31 @@ def points_problems(lab, page):
     return problems
 
 
+def todo_problems(lab, page):
+    """The stub's TODO comments ("TODO(lab12.5) [4 pts]", or "[with lab06.4:
+    2 pts]" for two functions graded together) against the handout's task
+    table: a row's points go to the TODOs its first cell names, a row with an
+    empty first cell to the row above; rows of whole steps ("all five") and
+    joint rows no TODO names are the table's own."""
+    todo = {}
+    for path in sorted((ROOT / "labs" / lab).glob("*.cpp")):
+        for match in re.finditer(r"TODO\((lab\d+\.\d+)\) \[(?:with (lab\d+\.\d+): )?(\d+) pts?\]",
+                                 path.read_text(encoding="utf-8")):
+            key = " + ".join(sorted({match.group(1), match.group(2)} - {None}))
+            todo[key] = todo.get(key, 0) + int(match.group(3)) if match.group(2) is None else int(match.group(3))
+    table, key = {}, None
+    rows = re.search(r"\n## [^\n]*[Tt]ask[^\n]*\n(?:[^|\n][^\n]*\n|\n)*((?:\|[^\n]*\n)+)", page)
+    for row in (rows.group(1).splitlines()[2:] if rows else []):
+        cells = [cell.strip() for cell in row.strip().strip("|").split("|")]
+        if cells[0]:
+            key = " + ".join(sorted(re.findall(r"lab\d+\.\d+", cells[0]))) or None
+        if key and len(cells) > 2 and cells[2].isdigit():
+            table[key] = table.get(key, 0) + int(cells[2])
+    return [f"TODO({key}) in labs/{lab}/ gives {todo.get(key, 'no')} points, the task table {table.get(key, 'none')}"
+            for key in sorted(set(todo) | {key for key in table if " + " not in key or key in todo})
+            if todo.get(key) != table.get(key)]
+
+
 def check_page(path, week):
     result = PageResult(str(path.relative_to(ROOT)), week)
     checker = PageChecker(week)
@@ -387,6 +412,8 @@ def check_handouts(labs):
         result.checked += 1
         result.problems += [f"points: {problem}" for problem in
                             points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
+        result.problems += [f"points: {problem}" for problem in
+                            todo_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
     if set(labs) == set(lab_dirs()):
         results += [check_page(page, 0) for page in FRONT_PAGES]
     return results
