@@ -351,8 +351,10 @@ def todo_problems(lab, page):
     for path in sorted((ROOT / "labs" / lab).glob("*.cpp")):
         for match in re.finditer(r"TODO\((lab\d+\.\d+)\) \[(?:with (lab\d+\.\d+): )?(\d+) pts?\]",
                                  path.read_text(encoding="utf-8")):
-            key = " + ".join(sorted({match.group(1), match.group(2)} - {None}))
-            todo[key] = todo.get(key, 0) + int(match.group(3)) if match.group(2) is None else int(match.group(3))
+            if match.group(2):  # "[with lab06.4: 2 pts]": both TODOs name the same joint points
+                todo[" + ".join(sorted(match.group(1, 2)))] = int(match.group(3))
+            else:  # one TODO may be split over functions (lab13.5's two comments)
+                todo[match.group(1)] = todo.get(match.group(1), 0) + int(match.group(3))
     table, key = {}, None
     rows = re.search(r"\n## [^\n]*[Tt]ask[^\n]*\n(?:[^|\n][^\n]*\n|\n)*((?:\|[^\n]*\n)+)", page)
     for row in (rows.group(1).splitlines()[2:] if rows else []):
@@ -410,10 +412,8 @@ def check_handouts(labs):
     results = [check_page(ROOT / "labs" / lab / "README.md", lab_number(lab)) for lab in labs]
     for lab, result in zip(labs, results):  # and its point totals, as one more check
         result.checked += 1
-        result.problems += [f"points: {problem}" for problem in
-                            points_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
-        result.problems += [f"points: {problem}" for problem in
-                            todo_problems(lab, (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8"))]
+        page = (ROOT / "labs" / lab / "README.md").read_text(encoding="utf-8")
+        result.problems += [f"points: {problem}" for problem in points_problems(lab, page) + todo_problems(lab, page)]
     if set(labs) == set(lab_dirs()):
         results += [check_page(page, 0) for page in FRONT_PAGES]
     return results

@@ -345,13 +345,15 @@ def ensure(command, system=None, log_path=None, recommends=True):
     if not required:
         return 0, None
     if system.kind == "debian" and system.root and system.apt_known is None:
-        log_path = log_path or ROOT / os.environ.get("CL_BUILD_DIR", "build") / "apt.log"
+        build_dir = ROOT / os.environ.get("CL_BUILD_DIR", "build")
+        log_path = log_path or build_dir / "apt.log"
         if not install(required + optional, system, log_path, recommends):
             return 1, f"course {command}: apt-get failed, see {shown(log_path)}"
         # A tree configured before this install cached what it did not find
         # (Google Benchmark, Boost): the stamp makes the next build configure
         # again (build.configure), so nothing installed now stays unused.
-        (log_path.parent / INSTALLED_STAMP).touch()
+        build_dir.mkdir(parents=True, exist_ok=True)
+        (build_dir / INSTALLED_STAMP).touch()
         system.found.clear()
         importlib.invalidate_caches()  # python3-matplotlib and the like, just installed for this Python
         required, _ = missing(command, system)
